@@ -1,0 +1,1 @@
+"""Case generator: gap -> mesh -> OpenFOAM case files."""

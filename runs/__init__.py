@@ -1,0 +1,1 @@
+"""Running OpenFOAM cases, the ehlfoam command line and its runtime."""
