@@ -1,0 +1,256 @@
+"""Discrete Reynolds operator and its line relaxation (numba kernels).
+
+Dimensionless steady Reynolds equation of the circular point contact in pure rolling
+(Venner & Lubrecht, *Multilevel Methods in Lubrication*, 2000):
+
+    d/dX(eps dP/dX) + d/dY(eps dP/dY) - d(rho H)/dX = f,   eps = rho H^3 / (eta lambda)
+
+Second-order central differences for the Poiseuille terms, second-order upstream
+differences for the wedge term (first order next to the inlet boundary). Arrays are indexed
+``[j, i]`` with i along X (the rolling direction) and j along Y.
+
+Relaxation: X-line relaxation that is Gauss-Seidel where the Poiseuille term dominates
+(eps / h^2 >= switch) and distributive Jacobi (changes distributed as d - (neighbours)/4)
+where it degenerates, each line a Newton step on a pentadiagonal system that includes the
+near elastic influence coefficients along the line.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _wedge_c(i):
+    if i >= 2:
+        return 1.5, -2.0, 0.5
+    return 1.0, -1.0, 0.0
+
+
+@njit(cache=True)
+def _residual_at(P, rhoH, eps, f, j, i, hx2, hy2, hx):
+    e0 = eps[j, i]
+    exm = 0.5 * (eps[j, i - 1] + e0)
+    exp_ = 0.5 * (eps[j, i + 1] + e0)
+    eym = 0.5 * (eps[j - 1, i] + e0)
+    eyp = 0.5 * (eps[j + 1, i] + e0)
+    p0 = P[j, i]
+    pois = (exm * (P[j, i - 1] - p0) + exp_ * (P[j, i + 1] - p0)) / hx2 + (
+        eym * (P[j - 1, i] - p0) + eyp * (P[j + 1, i] - p0)
+    ) / hy2
+    c1, c2, c3 = _wedge_c(i)
+    wedge = c1 * rhoH[j, i] + c2 * rhoH[j, i - 1]
+    if c3 != 0.0:
+        wedge += c3 * rhoH[j, i - 2]
+    return f[j, i] - (pois - wedge / hx), wedge / hx
+
+
+@njit(cache=True)
+def residual(P, rhoH, eps, f, hx, hy, r, wedge):
+    """Residual r = f - L(P) and the wedge term at interior points (boundaries 0)."""
+    ny, nx = P.shape
+    hx2, hy2 = hx * hx, hy * hy
+    r[:] = 0.0
+    wedge[:] = 0.0
+    for j in range(1, ny - 1):
+        for i in range(1, nx - 1):
+            rr, ww = _residual_at(P, rhoH, eps, f, j, i, hx2, hy2, hx)
+            r[j, i] = rr
+            wedge[j, i] = ww
+    return r
+
+
+@njit(cache=True)
+def _penta_solve(a, b, c, d, e, rhs, x):
+    """Solve a pentadiagonal system without pivoting.
+
+    Row m: a[m] x[m-2] + b[m] x[m-1] + c[m] x[m] + d[m] x[m+1] + e[m] x[m+2] = rhs[m].
+    The arrays are overwritten.
+    """
+    n = c.shape[0]
+    for m in range(n - 1):
+        piv = c[m]
+        # eliminate x[m] from row m+1
+        f1 = b[m + 1] / piv
+        c[m + 1] -= f1 * d[m]
+        d[m + 1] -= f1 * e[m]
+        rhs[m + 1] -= f1 * rhs[m]
+        b[m + 1] = 0.0
+        if m + 2 < n:
+            f2 = a[m + 2] / piv
+            b[m + 2] -= f2 * d[m]
+            c[m + 2] -= f2 * e[m]
+            rhs[m + 2] -= f2 * rhs[m]
+            a[m + 2] = 0.0
+    x[n - 1] = rhs[n - 1] / c[n - 1]
+    if n >= 2:
+        x[n - 2] = (rhs[n - 2] - d[n - 2] * x[n - 1]) / c[n - 2]
+    for m in range(n - 3, -1, -1):
+        x[m] = (rhs[m] - d[m] * x[m + 1] - e[m] * x[m + 2]) / c[m]
+
+
+@njit(cache=True)
+def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, clip, neumann_out, D,
+          point_ja=True):
+    """One X-line relaxation sweep; updates P in place.
+
+    Args:
+        P, H, rho, drho, eps, f: pressure, film, density and its P-derivative, Poiseuille
+            coefficient, right-hand side; H, rho, drho, eps are frozen during the sweep.
+        K0, K1: influence coefficients K[0, k], K[1, k] for k = 0..5 (along the line and
+            the neighbouring line).
+        switch: Gauss-Seidel where eps / hx^2 >= switch, distributive Jacobi elsewhere.
+        w_gs, w_ja: under-relaxation factors.
+        clip: enforce P >= 0 (complementarity cavitation).
+        neumann_out: zero-gradient outlet (P[:, -1] = P[:, -2]) instead of P = 0.
+        D: work array (Jacobi changes).
+    Returns:
+        The number of distributive-Jacobi points in the sweep.
+    """
+    ny, nx = P.shape
+    n = nx - 2
+    hx2, hy2 = hx * hx, hy * hy
+    rhoH = rho * H
+    Kt = np.empty(6)
+    for k in range(5):
+        km = K0[abs(k - 1)]
+        Kt[k] = K0[k] - 0.25 * (km + K0[k + 1] + 2.0 * K1[k])
+    Kt[5] = 0.0
+    a = np.empty(n)
+    b = np.empty(n)
+    c = np.empty(n)
+    d = np.empty(n)
+    e = np.empty(n)
+    rhs = np.empty(n)
+    x = np.empty(n)
+    gs = np.empty(n, dtype=np.bool_)
+    frozen = np.empty(n, dtype=np.bool_)
+    D[:] = 0.0
+    n_ja = 0
+    for j in range(1, ny - 1):
+        for m in range(n):
+            i = m + 1
+            rr, ww = _residual_at(P, rhoH, eps, f, j, i, hx2, hy2, hx)
+            rhs[m] = rr
+            gs[m] = eps[j, i] >= switch * hx2
+            frozen[m] = clip and P[j, i] <= 0.0 and rr > 0.0
+        for m in range(n):
+            i = m + 1
+            a[m] = 0.0
+            b[m] = 0.0
+            c[m] = 0.0
+            d[m] = 0.0
+            e[m] = 0.0
+            if frozen[m]:
+                c[m] = 1.0
+                rhs[m] = 0.0
+                continue
+            e0 = eps[j, i]
+            exm = 0.5 * (eps[j, i - 1] + e0) / hx2
+            exp_ = 0.5 * (eps[j, i + 1] + e0) / hx2
+            ey = 0.5 * (eps[j - 1, i] + 2.0 * e0 + eps[j + 1, i]) / hy2
+            diag = -(exm + exp_) - ey
+            if neumann_out and i == nx - 2:
+                diag += exp_
+            c1, c2, c3 = _wedge_c(i)
+            for off in range(-2, 3):
+                mc = m + off
+                if mc < 0 or mc >= n or frozen[mc]:
+                    continue
+                col = i + off
+                v = 0.0
+                if gs[mc]:
+                    if off == 0:
+                        v += diag
+                    elif off == -1:
+                        v += exm
+                    elif off == 1:
+                        v += exp_
+                    v -= c1 * rho[j, i] * K0[abs(i - col)] / hx
+                    v -= c2 * rho[j, i - 1] * K0[abs(i - 1 - col)] / hx
+                    if c3 != 0.0:
+                        v -= c3 * rho[j, i - 2] * K0[abs(i - 2 - col)] / hx
+                    if off == 0:
+                        v -= c1 * H[j, i] * drho[j, i] / hx
+                    elif off == -1:
+                        v -= c2 * H[j, i - 1] * drho[j, i - 1] / hx
+                    elif off == -2:
+                        v -= c3 * H[j, i - 2] * drho[j, i - 2] / hx
+                elif off == 0 or not point_ja:
+                    # distribution: +1 at col, -1/4 at col +- 1 and at (j +- 1, col)
+                    if off == 0:
+                        v += diag - 0.25 * (exm + exp_) - 0.25 * ey
+                    elif off == -1:
+                        v += exm - 0.25 * diag
+                    elif off == 1:
+                        v += exp_ - 0.25 * diag
+                    elif off == -2:
+                        v -= 0.25 * exm
+                    else:
+                        v -= 0.25 * exp_
+                    v -= c1 * rho[j, i] * Kt[abs(i - col)] / hx
+                    v -= c2 * rho[j, i - 1] * Kt[abs(i - 1 - col)] / hx
+                    if c3 != 0.0:
+                        v -= c3 * rho[j, i - 2] * Kt[abs(i - 2 - col)] / hx
+                    # local density derivative of the wedge term, distributed
+                    for q in range(3):
+                        cq = c1 if q == 0 else (c2 if q == 1 else c3)
+                        iq = i - q
+                        if cq == 0.0 or iq < 0:
+                            continue
+                        dq = iq - col
+                        wq = 1.0 if dq == 0 else (-0.25 if (dq == 1 or dq == -1) else 0.0)
+                        if wq != 0.0:
+                            v -= cq * H[j, iq] * drho[j, iq] * wq / hx
+                if off == -2:
+                    a[m] = v
+                elif off == -1:
+                    b[m] = v
+                elif off == 0:
+                    c[m] = v
+                elif off == 1:
+                    d[m] = v
+                else:
+                    e[m] = v
+        _penta_solve(a, b, c, d, e, rhs, x)
+        for m in range(n):
+            i = m + 1
+            if frozen[m]:
+                continue
+            if gs[m]:
+                v = P[j, i] + w_gs * x[m]
+                if clip and v < 0.0:
+                    v = 0.0
+                P[j, i] = v
+            else:
+                D[j, i] = x[m]
+                n_ja += 1
+        if neumann_out:
+            P[j, nx - 1] = P[j, nx - 2]
+    if n_ja > 0:
+        for j in range(1, ny - 1):
+            for i in range(1, nx - 1):
+                dd = D[j, i]
+                if dd == 0.0:
+                    continue
+                dd *= w_ja
+                P[j, i] += dd
+                q = 0.25 * dd
+                if i > 1:
+                    P[j, i - 1] -= q
+                if i < nx - 2:
+                    P[j, i + 1] -= q
+                if j > 1:
+                    P[j - 1, i] -= q
+                if j < ny - 2:
+                    P[j + 1, i] -= q
+        if clip:
+            for j in range(1, ny - 1):
+                for i in range(1, nx - 1):
+                    if P[j, i] < 0.0:
+                        P[j, i] = 0.0
+        if neumann_out:
+            for j in range(ny):
+                P[j, nx - 1] = P[j, nx - 2]
+    return n_ja

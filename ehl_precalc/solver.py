@@ -1,0 +1,145 @@
+"""Solve a :class:`~ehl_precalc.spec.PrecalcSpec`: domain and grid choice, load continuation,
+and the SI result (summary numbers, fields, the gap).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .formulas import Contact, moes_to_hertz_film, nijenbanning_moes_hc
+from .multigrid import Domain, MGResult, MultigridSolver, Problem, SolverOptions
+from .spec import PrecalcSpec
+
+#: Above this Moes M the solve starts from a converged solution at a lower M (speed ramp).
+CONTINUATION_M = 2000.0
+
+
+def default_grid(M: float) -> int:
+    """Grid points per side that keep hc within 2 % of the grid-converged value."""
+    return 513 if M < 300.0 else 1025
+
+
+def domain_for(spec: PrecalcSpec, M: float, n: int) -> Domain:
+    """Computational domain in units of a (two-phase: the thesis's x in [-2, 6], y in [-2, 2])."""
+    if spec.cavitation == "twophase":
+        return Domain(-2.0, 6.0, 2.0, 2 * n - 1, n)
+    if M < 300.0:
+        return Domain(-4.5, 1.5, 3.0, n, n)
+    return Domain(-2.5, 1.5, 2.0, n, n)
+
+
+@dataclass
+class PrecalcResult:
+    """A solved contact: the spec, the contact data, the fields and the convergence record."""
+
+    spec: PrecalcSpec
+    contact: Contact
+    domain: Domain
+    mg: MGResult
+    wall_s: float
+    continuation: list
+
+    @property
+    def converged(self) -> bool:
+        return self.mg.converged
+
+    def centre_index(self) -> tuple[int, int]:
+        return int(np.argmin(np.abs(self.mg.y))), int(np.argmin(np.abs(self.mg.x)))
+
+    @property
+    def H_central(self) -> float:
+        j, i = self.centre_index()
+        return float(self.mg.H[j, i])
+
+    def cavity_length_over_a(self) -> float:
+        """Length of the sub-ambient region behind the contact on y = 0, from x = a (units a)."""
+        j, _ = self.centre_index()
+        x, p = self.mg.x, self.mg.P[j]
+        behind = x >= 1.0
+        neg = np.where(behind & (p < 0.0))[0]
+        if neg.size == 0:
+            return 0.0
+        end = neg[0]
+        while end + 1 < len(x) and p[end + 1] < 0.0:
+            end += 1
+        return float(x[end] - 1.0)
+
+    def summary(self) -> dict:
+        """The JSON contract (SI units, plus dimensionless groups)."""
+        c = self.contact
+        scale = c.film_scale
+        p = self.mg.P * c.p_hertz
+        out = {
+            "a_m": c.a,
+            "p_hertz_Pa": c.p_hertz,
+            "M": c.M,
+            "L": c.L,
+            "lambda": c.lam,
+            "hc_m": self.H_central * scale,
+            "hmin_m": float(self.mg.H.min()) * scale,
+            "p_max_Pa": float(p.max()),
+            "p_min_Pa": float(p.min()),
+            "h0_m": self.mg.H0 * scale,
+            "converged": bool(self.converged),
+            "residual": self.mg.residual,
+            "load_error": self.mg.load_error,
+            "cycles": self.mg.cycles,
+            "grid": [self.domain.nx, self.domain.ny],
+            "domain_over_a": [self.domain.x_min, self.domain.x_max, -self.domain.y_half,
+                              self.domain.y_half],
+            "wall_s": self.wall_s,
+            "hc_nvm_m": moes_to_hertz_film(nijenbanning_moes_hc(c.M, c.L), c.M) * scale
+            if c.L > 0 else None,
+            "failure": self.mg.failure or None,
+            "continuation_M": self.continuation,
+            "spec": self.spec.model_dump(),
+        }
+        if self.spec.cavitation == "twophase":
+            out["cavity_length_over_a"] = self.cavity_length_over_a()
+        return out
+
+
+def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcResult:
+    """Solve the EHL contact of ``spec``.
+
+    Above :data:`CONTINUATION_M` (or when a direct start fails) the solution is reached by a
+    speed ramp: M is stepped up by factors of at most 2 from a directly solvable M, each step
+    starting from the previous converged pressure and film constant.
+    """
+    t0 = time.perf_counter()
+    c = spec.contact()
+    n = spec.grid or default_grid(c.M)
+    dom = domain_for(spec, c.M, n)
+    opt = options or SolverOptions(max_cycles=spec.max_cycles, tol_residual=spec.tol_residual,
+                                   tol_load=spec.tol_load)
+    twophase = spec.cavitation == "twophase"
+    prob = Problem(lam=c.lam, laws=spec.laws(), clip=not twophase, neumann_outlet=twophase,
+                   moes_M=c.M)
+    solver = MultigridSolver(prob, dom, opt)
+
+    def h0_guess(M: float) -> float:
+        return moes_to_hertz_film(nijenbanning_moes_hc(M, max(c.L, 1e-9)), M) - 1.0
+
+    ramp: list[float] = []
+    result = None
+    if c.M <= CONTINUATION_M:
+        result = solver.solve(h0_guess(c.M))
+    if result is None or not result.converged:
+        steps = max(1, math.ceil(math.log2(c.M / min(c.M, CONTINUATION_M / 2))))
+        M_start = c.M / 2**steps
+        ramp = [M_start * 2**k for k in range(steps + 1)]
+        P = None
+        H0 = h0_guess(M_start)
+        for M_k in ramp:
+            lam_k = c.lam * (M_k / c.M) ** (-4.0 / 3.0)  # M ~ u^-3/4 at fixed load
+            solver.prob = replace(prob, lam=lam_k, moes_M=M_k)
+            result = solver.solve(H0, P_init=P)
+            if not np.all(np.isfinite(result.P)):
+                break
+            P, H0 = result.P, result.H0
+    return PrecalcResult(spec=spec, contact=c, domain=dom, mg=result,
+                         wall_s=time.perf_counter() - t0, continuation=ramp)
