@@ -59,11 +59,12 @@ class SolverOptions:
     w_gs: float = 0.4
     w_ja: float = 0.2
     coarsest_min_points: int = 33
-    coarse_sweeps: int = 40
+    coarse_sweeps: int = 10
+    coarse_rounds: int = 1
     h0_gain: float = 0.05
     fmg_cycles: int = 2
-    max_cycles: int = 40
-    tol_residual: float = 1e-4
+    max_cycles: int = 60
+    tol_residual: float = 3e-5
     tol_load: float = 1e-5
 
 
@@ -136,6 +137,21 @@ def _restrict_full_weighting(r: np.ndarray) -> np.ndarray:
     return rc
 
 
+def _restrict_pressure(P: np.ndarray) -> np.ndarray:
+    """Coarse pressure: full weighting where the 3x3 fine neighbourhood is pressurised,
+    injection near the cavitation boundary and the domain boundary (keeps P >= 0 sharp)."""
+    Pc = P[::2, ::2].copy()
+    fw = _restrict_full_weighting(P)
+    pos = P > 0.0
+    allpos = np.zeros_like(Pc, dtype=bool)
+    allpos[1:-1, 1:-1] = (
+        pos[2:-2:2, 2:-2:2] & pos[2:-2:2, 1:-3:2] & pos[2:-2:2, 3:-1:2] & pos[1:-3:2, 2:-2:2]
+        & pos[3:-1:2, 2:-2:2] & pos[1:-3:2, 1:-3:2] & pos[1:-3:2, 3:-1:2] & pos[3:-1:2, 1:-3:2]
+        & pos[3:-1:2, 3:-1:2])
+    Pc[allpos] = fw[allpos]
+    return Pc
+
+
 def _prolong_bilinear(c: np.ndarray) -> np.ndarray:
     ny, nx = 2 * c.shape[0] - 1, 2 * c.shape[1] - 1
     f = np.zeros((ny, nx))
@@ -196,10 +212,11 @@ class MultigridSolver:
     def _solve_coarsest(self) -> None:
         lv = self.levels[0]
         opt = self.opt
-        for _ in range(opt.coarse_sweeps // 2):
-            lv.relax(self.H0, self.prob, opt)
-        self.H0 += self.h0_gain * (lv.load(lv.P) - lv.load_target)
-        for _ in range(opt.coarse_sweeps // 2):
+        for _ in range(opt.coarse_rounds):
+            for _ in range(opt.coarse_sweeps):
+                lv.relax(self.H0, self.prob, opt)
+            self.H0 += self.h0_gain * (lv.load(lv.P) - lv.load_target)
+        for _ in range(opt.coarse_sweeps):
             lv.relax(self.H0, self.prob, opt)
 
     def _cycle(self, k: int) -> None:
@@ -211,7 +228,7 @@ class MultigridSolver:
         for _ in range(opt.nu1):
             lv.relax(self.H0, prob, opt)
         r, _, _ = lv.residual(lv.P, self.H0, prob)
-        P_hat = lv.P[::2, ::2].copy()
+        P_hat = _restrict_pressure(lv.P)
         co.P = P_hat.copy()
         Wf = lv.deform(lv.P) + lv.tauW
         co.tauW = np.zeros_like(P_hat)

@@ -133,7 +133,11 @@ def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, clip, neu
             i = m + 1
             rr, ww = _residual_at(P, rhoH, eps, f, j, i, hx2, hy2, hx)
             rhs[m] = rr
-            gs[m] = eps[j, i] >= switch * hx2
+            # distributive Jacobi only where the distribution stays inside the pressurised
+            # zone: near the cavitation boundary its zero-sum property would be clipped away
+            gs[m] = eps[j, i] >= switch * hx2 or (clip and (
+                P[j, i] <= 0.0 or P[j, i - 1] <= 0.0 or P[j, i + 1] <= 0.0
+                or P[j - 1, i] <= 0.0 or P[j + 1, i] <= 0.0))
             frozen[m] = clip and P[j, i] <= 0.0 and rr > 0.0
         for m in range(n):
             i = m + 1

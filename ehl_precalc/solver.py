@@ -14,8 +14,11 @@ from .formulas import Contact, moes_to_hertz_film, nijenbanning_moes_hc
 from .multigrid import Domain, MGResult, MultigridSolver, Problem, SolverOptions
 from .spec import PrecalcSpec
 
-#: Above this Moes M the solve starts from a converged solution at a lower M (speed ramp).
-CONTINUATION_M = 2000.0
+#: Above this Moes M (or when a direct start fails) the solve starts from a solution at a
+#: lower M (speed ramp).
+CONTINUATION_M = 5000.0
+#: Multigrid cycles spent on each intermediate step of the speed ramp.
+RAMP_CYCLES = 4
 
 
 def default_grid(M: float) -> int:
@@ -29,7 +32,10 @@ def domain_for(spec: PrecalcSpec, M: float, n: int) -> Domain:
         return Domain(-2.0, 6.0, 2.0, 2 * n - 1, n)
     if M < 300.0:
         return Domain(-4.5, 1.5, 3.0, n, n)
-    return Domain(-2.5, 1.5, 2.0, n, n)
+    if M < 1000.0:
+        return Domain(-2.5, 1.5, 2.0, n, n)
+    # heavily loaded: the inlet zone is a fraction of a; spend the points near the contact
+    return Domain(-1.8, 1.2, 1.5, n, n)
 
 
 @dataclass
@@ -129,14 +135,15 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
     if c.M <= CONTINUATION_M:
         result = solver.solve(h0_guess(c.M))
     if result is None or not result.converged:
-        steps = max(1, math.ceil(math.log2(c.M / min(c.M, CONTINUATION_M / 2))))
+        steps = max(1, math.ceil(math.log2(c.M / min(c.M, CONTINUATION_M / 4))))
         M_start = c.M / 2**steps
         ramp = [M_start * 2**k for k in range(steps + 1)]
         P = None
         H0 = h0_guess(M_start)
-        for M_k in ramp:
+        for k, M_k in enumerate(ramp):
             lam_k = c.lam * (M_k / c.M) ** (-4.0 / 3.0)  # M ~ u^-3/4 at fixed load
             solver.prob = replace(prob, lam=lam_k, moes_M=M_k)
+            solver.opt = opt if k == steps else replace(opt, max_cycles=RAMP_CYCLES)
             result = solver.solve(H0, P_init=P)
             if not np.all(np.isfinite(result.P)):
                 break
