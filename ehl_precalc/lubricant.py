@@ -76,7 +76,9 @@ class PressureLaws:
         viscosity: "roelands" or "barus".
         density: "dowson-higginson" or "incompressible".
         twophase_p_scale: for the two-phase model, the pressure scale p_s [Pa] of the density
-            drop below ambient, rho/rho0 = exp(p / p_s) for gauge p < 0; None = no two-phase.
+            drop below ambient: rho/rho0 = max(0, 1 + p / p_s) for gauge p < 0, i.e. with
+            p_s = p_ambient a gas-oil mixture whose density is proportional to the absolute
+            pressure (ideal gas, isothermal), zero at vacuum; None = no two-phase.
     """
 
     p_hertz: float
@@ -106,9 +108,8 @@ class PressureLaws:
             drho = ph * (DH_B - 1.0) * DH_A_PA / (DH_A_PA + p) ** 2
         if self.twophase_p_scale is not None:
             neg = P < 0.0
+            slope = ph / self.twophase_p_scale
             if np.any(neg):
-                ps = self.twophase_p_scale / ph
-                e = np.exp(np.minimum(P, 0.0) / ps)
-                rho = np.where(neg, e, rho)
-                drho = np.where(neg, e / ps, drho)
+                rho = np.where(neg, np.maximum(1.0 + P * slope, 0.0), rho)
+                drho = np.where(neg, slope, drho)
         return rho, drho

@@ -74,7 +74,7 @@ class Problem:
 
     lam: float
     laws: PressureLaws
-    clip: bool = True
+    p_floor: float = 0.0
     neumann_outlet: bool = False
     moes_M: float = 100.0
 
@@ -117,14 +117,14 @@ class Level:
         r = np.zeros_like(P)
         wedge = np.zeros_like(P)
         residual(P, rho * H, eps, self.f if f is None else f, self.h, self.h, r, wedge)
-        if prob.clip and not raw:
-            r[(P <= 0.0) & (r > 0.0)] = 0.0
+        if not raw:
+            r[(P <= prob.p_floor) & (r > 0.0)] = 0.0
         return r, wedge, H
 
     def relax(self, H0: float, prob: Problem, opt: SolverOptions) -> None:
         H, rho, drho, eps = self.coefficients(self.P, H0, prob)
         relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
-              opt.switch, opt.w_gs, opt.w_ja, prob.clip, prob.neumann_outlet, self.work)
+              opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet, self.work)
 
 
 def _restrict_full_weighting(r: np.ndarray) -> np.ndarray:
@@ -137,12 +137,12 @@ def _restrict_full_weighting(r: np.ndarray) -> np.ndarray:
     return rc
 
 
-def _restrict_pressure(P: np.ndarray) -> np.ndarray:
+def _restrict_pressure(P: np.ndarray, p_floor: float) -> np.ndarray:
     """Coarse pressure: full weighting where the 3x3 fine neighbourhood is pressurised,
     injection near the cavitation boundary and the domain boundary (keeps P >= 0 sharp)."""
     Pc = P[::2, ::2].copy()
     fw = _restrict_full_weighting(P)
-    pos = P > 0.0
+    pos = P > p_floor
     allpos = np.zeros_like(Pc, dtype=bool)
     allpos[1:-1, 1:-1] = (
         pos[2:-2:2, 2:-2:2] & pos[2:-2:2, 1:-3:2] & pos[2:-2:2, 3:-1:2] & pos[1:-3:2, 2:-2:2]
@@ -206,8 +206,7 @@ class MultigridSolver:
             P[:, -1] = P[:, -2]
         else:
             P[:, -1] = 0.0
-        if self.prob.clip:
-            np.maximum(P, 0.0, out=P)
+        np.maximum(P, self.prob.p_floor, out=P)
 
     def _solve_coarsest(self) -> None:
         lv = self.levels[0]
@@ -228,7 +227,7 @@ class MultigridSolver:
         for _ in range(opt.nu1):
             lv.relax(self.H0, prob, opt)
         r, _, _ = lv.residual(lv.P, self.H0, prob)
-        P_hat = _restrict_pressure(lv.P)
+        P_hat = _restrict_pressure(lv.P, prob.p_floor)
         co.P = P_hat.copy()
         Wf = lv.deform(lv.P) + lv.tauW
         co.tauW = np.zeros_like(P_hat)
@@ -240,8 +239,7 @@ class MultigridSolver:
         for _ in range(opt.gamma if k > 1 else 1):
             self._cycle(k - 1)
         corr = _prolong_bilinear(co.P - P_hat)
-        if prob.clip:
-            corr[lv.P <= 0.0] = 0.0  # no correction inside the cavitated region
+        corr[lv.P <= prob.p_floor] = 0.0  # no correction inside the cavitated region
         lv.P += corr
         self._enforce_bc(lv)
         for _ in range(opt.nu2):

@@ -91,7 +91,7 @@ def _penta_solve(a, b, c, d, e, rhs, x):
 
 
 @njit(cache=True)
-def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, clip, neumann_out, D,
+def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, p_floor, neumann_out, D,
           point_ja=True):
     """One X-line relaxation sweep; updates P in place.
 
@@ -102,7 +102,8 @@ def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, clip, neu
             the neighbouring line).
         switch: Gauss-Seidel where eps / hx^2 >= switch, distributive Jacobi elsewhere.
         w_gs, w_ja: under-relaxation factors.
-        clip: enforce P >= 0 (complementarity cavitation).
+        p_floor: cavitation pressure: P >= p_floor is enforced (complementarity; 0 for
+            the classic p >= 0 condition, absolute zero for the two-phase model).
         neumann_out: zero-gradient outlet (P[:, -1] = P[:, -2]) instead of P = 0.
         D: work array (Jacobi changes).
     Returns:
@@ -135,10 +136,10 @@ def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, clip, neu
             rhs[m] = rr
             # distributive Jacobi only where the distribution stays inside the pressurised
             # zone: near the cavitation boundary its zero-sum property would be clipped away
-            gs[m] = eps[j, i] >= switch * hx2 or (clip and (
-                P[j, i] <= 0.0 or P[j, i - 1] <= 0.0 or P[j, i + 1] <= 0.0
-                or P[j - 1, i] <= 0.0 or P[j + 1, i] <= 0.0))
-            frozen[m] = clip and P[j, i] <= 0.0 and rr > 0.0
+            gs[m] = eps[j, i] >= switch * hx2 or (
+                P[j, i] <= p_floor or P[j, i - 1] <= p_floor or P[j, i + 1] <= p_floor
+                or P[j - 1, i] <= p_floor or P[j + 1, i] <= p_floor)
+            frozen[m] = P[j, i] <= p_floor and rr > 0.0
         for m in range(n):
             i = m + 1
             a[m] = 0.0
@@ -175,12 +176,13 @@ def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, clip, neu
                     v -= c2 * rho[j, i - 1] * K0[abs(i - 1 - col)] / hx
                     if c3 != 0.0:
                         v -= c3 * rho[j, i - 2] * K0[abs(i - 2 - col)] / hx
+                    # density derivative of the wedge term, first-order upwind: the
+                    # second-order (1.5, -2, 0.5) weights make the line system amplify
+                    # errors downstream where d(rho)/dP is large (two-phase region)
                     if off == 0:
-                        v -= c1 * H[j, i] * drho[j, i] / hx
+                        v -= H[j, i] * drho[j, i] / hx
                     elif off == -1:
-                        v -= c2 * H[j, i - 1] * drho[j, i - 1] / hx
-                    elif off == -2:
-                        v -= c3 * H[j, i - 2] * drho[j, i - 2] / hx
+                        v += H[j, i - 1] * drho[j, i - 1] / hx
                 elif off == 0 or not point_ja:
                     # distribution: +1 at col, -1/4 at col +- 1 and at (j +- 1, col)
                     if off == 0:
@@ -197,12 +199,11 @@ def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, clip, neu
                     v -= c2 * rho[j, i - 1] * Kt[abs(i - 1 - col)] / hx
                     if c3 != 0.0:
                         v -= c3 * rho[j, i - 2] * Kt[abs(i - 2 - col)] / hx
-                    # local density derivative of the wedge term, distributed
-                    for q in range(3):
-                        cq = c1 if q == 0 else (c2 if q == 1 else c3)
+                    # local density derivative of the wedge term (first-order upwind),
+                    # distributed
+                    for q in range(2):
+                        cq = 1.0 if q == 0 else -1.0
                         iq = i - q
-                        if cq == 0.0 or iq < 0:
-                            continue
                         dq = iq - col
                         wq = 1.0 if dq == 0 else (-0.25 if (dq == 1 or dq == -1) else 0.0)
                         if wq != 0.0:
@@ -224,8 +225,8 @@ def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, clip, neu
                 continue
             if gs[m]:
                 v = P[j, i] + w_gs * x[m]
-                if clip and v < 0.0:
-                    v = 0.0
+                if v < p_floor:
+                    v = p_floor
                 P[j, i] = v
             else:
                 D[j, i] = x[m]
@@ -249,11 +250,10 @@ def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, clip, neu
                     P[j - 1, i] -= q
                 if j < ny - 2:
                     P[j + 1, i] -= q
-        if clip:
-            for j in range(1, ny - 1):
-                for i in range(1, nx - 1):
-                    if P[j, i] < 0.0:
-                        P[j, i] = 0.0
+        for j in range(1, ny - 1):
+            for i in range(1, nx - 1):
+                if P[j, i] < p_floor:
+                    P[j, i] = p_floor
         if neumann_out:
             for j in range(ny):
                 P[j, nx - 1] = P[j, nx - 2]

@@ -12,7 +12,7 @@ import numpy as np
 
 from .formulas import Contact, moes_to_hertz_film, nijenbanning_moes_hc
 from .multigrid import Domain, MGResult, MultigridSolver, Problem, SolverOptions
-from .spec import PrecalcSpec
+from .spec import P_AMBIENT_PA, PrecalcSpec
 
 #: Above this Moes M (or when a direct start fails) the solve starts from a solution at a
 #: lower M (speed ramp).
@@ -123,7 +123,9 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
     opt = options or SolverOptions(max_cycles=spec.max_cycles, tol_residual=spec.tol_residual,
                                    tol_load=spec.tol_load)
     twophase = spec.cavitation == "twophase"
-    prob = Problem(lam=c.lam, laws=spec.laws(), clip=not twophase, neumann_outlet=twophase,
+    # two-phase: sub-ambient pressures allowed down to absolute zero (gauge -p_ambient)
+    p_floor = -P_AMBIENT_PA / c.p_hertz if twophase else 0.0
+    prob = Problem(lam=c.lam, laws=spec.laws(), p_floor=p_floor, neumann_outlet=twophase,
                    moes_M=c.M)
     solver = MultigridSolver(prob, dom, opt)
 

@@ -43,7 +43,8 @@ class PrecalcSpec(BaseModel):
         cavitation: "complementarity" (p >= 0) or "twophase" (density drop below ambient,
             zero-gradient outlet, domain x in [-2a, 6a], y in [-2a, 2a]).
         twophase_p_scale: pressure scale p_s [Pa] of the two-phase density,
-            rho/rho0 = exp(p/p_s) for gauge p < 0.
+            rho/rho0 = max(0, 1 + p/p_s) for gauge p < 0 (default p_ambient: density
+            proportional to absolute pressure).
         grid: grid points along y (2^k + 1); None chooses from the Moes load parameter.
         max_cycles: multigrid cycle limit.
         tol_residual, tol_load: convergence tolerances (relative).
@@ -63,7 +64,7 @@ class PrecalcSpec(BaseModel):
     viscosity: Literal["roelands", "barus"] = "roelands"
     density: Literal["dowson-higginson", "incompressible"] = "dowson-higginson"
     cavitation: Literal["complementarity", "twophase"] = "complementarity"
-    twophase_p_scale: float = Field(0.1 * P_AMBIENT_PA, gt=0.0, le=1e7)
+    twophase_p_scale: float = Field(P_AMBIENT_PA, gt=0.0, le=1e7)
     grid: int | None = None
     max_cycles: int = Field(60, ge=1, le=1000)
     tol_residual: float = Field(3e-5, gt=0.0, lt=1.0)
