@@ -10,7 +10,7 @@ import argparse
 import json
 import sys
 
-from .spec import PrecalcSpec, SpecError, load_spec, make_spec
+from .spec import PrecalcSpec, SpecError, load_spec, make_spec, valid_range
 
 _OPTIONS = {
     # flag: (spec key, type, help with units)
@@ -52,7 +52,10 @@ def _convert(flag: str, raw: str | None):
     try:
         return typ(raw)
     except ValueError:
-        raise SpecError(f"invalid input: {key} = {raw!r}: not a {typ.__name__}") from None
+        kind = "an integer" if typ is int else "a number"
+        rng = valid_range(key)
+        raise SpecError(f"invalid input: {key} = {raw!r}: not {kind}"
+                        + (f" ({rng})" if rng else "")) from None
 
 
 def spec_from_args(args: argparse.Namespace) -> PrecalcSpec:

@@ -27,10 +27,21 @@ def _atomic_write(path: Path, write) -> None:
         raise
 
 
+def _finite_or_none(value):
+    """JSON has no NaN/inf: a blown-up run reports null."""
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_finite_or_none(v) for v in value]
+    return value
+
+
 def write_summary(result: PrecalcResult, out: Path) -> dict:
-    summary = result.summary()
+    summary = _finite_or_none(result.summary())
     _atomic_write(out / "summary.json",
-                  lambda fh: fh.write(json.dumps(summary, indent=2).encode() + b"\n"))
+                  lambda fh: fh.write(json.dumps(summary, indent=2, allow_nan=False).encode() + b"\n"))
     return summary
 
 

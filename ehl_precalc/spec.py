@@ -50,7 +50,7 @@ class PrecalcSpec(BaseModel):
         tol_residual, tol_load: convergence tolerances (relative).
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     load: float = Field(20.0, gt=0.0, le=1e5)
     speed: float = Field(0.01, gt=0.0, le=100.0)
@@ -115,6 +115,28 @@ class PrecalcSpec(BaseModel):
                             if self.cavitation == "twophase" else None)
 
 
+UNITS = {"load": "N", "speed": "m/s", "temperature": "C", "eta0": "Pa s", "alpha": "1/Pa",
+         "rho0": "kg/m3", "radius": "m", "modulus": "Pa", "twophase_p_scale": "Pa"}
+
+
+def valid_range(name: str) -> str:
+    """The valid range of a numeric spec field, from its constraints (e.g. '0 < load <= 1e+05 N')."""
+    field = PrecalcSpec.model_fields.get(name)
+    if field is None:
+        return ""
+    lo = hi = ""
+    for m in field.metadata:
+        for attr, fmt in (("gt", "{} < "), ("ge", "{} <= ")):
+            if getattr(m, attr, None) is not None:
+                lo = fmt.format(f"{getattr(m, attr):g}")
+        for attr, fmt in (("lt", " < {}"), ("le", " <= {}")):
+            if getattr(m, attr, None) is not None:
+                hi = fmt.format(f"{getattr(m, attr):g}")
+    if not (lo or hi):
+        return ""
+    return f"valid range {lo}{name}{hi} {UNITS.get(name, '')}".rstrip()
+
+
 def _format_error(err: ValidationError) -> str:
     lines = []
     for e in err.errors():
@@ -123,7 +145,8 @@ def _format_error(err: ValidationError) -> str:
         if e["type"] == "extra_forbidden":
             lines.append(f"{loc}: unknown parameter (valid: {', '.join(PrecalcSpec.model_fields)})")
         elif "input" in e and e["loc"]:
-            lines.append(f"{loc} = {e['input']!r}: {msg}")
+            rng = valid_range(loc)
+            lines.append(f"{loc} = {e['input']!r}: {msg}" + (f" ({rng})" if rng else ""))
         else:
             lines.append(msg)
     return "; ".join(lines)

@@ -178,7 +178,7 @@ def test_twophase_cli_exits_cleanly(tmp_path, capsys):
 
 BAD = [
     # (argv, parameter, value as given, words of the valid range / choices)
-    (["--load", "-1"], "load", "-1", ["greater than 0"]),
+    (["--load", "-1"], "load", "-1", ["greater than 0", "0 < load <= 100000 N"]),
     (["--load", "0"], "load", "0", ["greater than 0"]),
     (["--speed", "0"], "speed", "0", ["greater than 0"]),
     (["--lubricant", "custom", "--eta0", "-0.02", "--alpha", "2e-8", "--rho0", "870"],
@@ -187,7 +187,7 @@ BAD = [
     (["--temperature", "80"], "temperature", "80", ["25", "60"]),
     (["--grid", "100"], "grid", "100", ["2**k + 1", "65", "8193"]),
     (["--grid", "33"], "grid", "33", ["2**k + 1", "65", "8193"]),
-    (["--load", "abc"], "load", "abc", ["float"]),
+    (["--load", "abc"], "load", "abc", ["not a number", "0 < load <= 100000 N"]),
     (["--viscosity", "sutherland"], "viscosity", "sutherland", ["roelands", "barus"]),
     (["--max-cycles", "0"], "max_cycles", "0", ["greater than or equal to 1"]),
 ]

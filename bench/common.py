@@ -1,0 +1,59 @@
+"""Shared helpers of the benchmark scripts: one solve per fresh process (so that its peak
+memory is its own and numba's compile time is paid before the clock starts)."""
+
+from __future__ import annotations
+
+import json
+import multiprocessing as mp
+import resource
+import sys
+import time
+from pathlib import Path
+
+RESULTS = Path(__file__).resolve().parent / "results"
+
+
+def _child(spec_kwargs: dict, options: dict | None, queue) -> None:
+    from ehl_precalc.multigrid import SolverOptions
+    from ehl_precalc.solver import solve
+    from ehl_precalc.spec import make_spec
+
+    solve(make_spec(**{**spec_kwargs, "grid": 65, "max_cycles": 2}))  # JIT warm-up
+    spec = make_spec(**spec_kwargs)
+    opt = None
+    if options:
+        opt = SolverOptions(**{"max_cycles": spec.max_cycles, "tol_residual": spec.tol_residual,
+                               "tol_load": spec.tol_load, **options})
+    t0 = time.perf_counter()
+    try:
+        result = solve(spec, opt)
+        summary = result.summary()
+        summary["nan"] = False
+    except Exception as err:  # noqa: BLE001 - a failed point of a map is data
+        summary = {"converged": False, "failure": f"{type(err).__name__}: {err}", "nan": True}
+    summary["wall_s"] = time.perf_counter() - t0
+    summary["peak_rss_GiB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
+    queue.put(summary)
+
+
+def solve_in_subprocess(spec_kwargs: dict, options: dict | None = None) -> dict:
+    """Solve in a fresh process; returns the summary plus wall_s and peak_rss_GiB."""
+    ctx = mp.get_context("spawn")
+    q = ctx.Queue()
+    p = ctx.Process(target=_child, args=(spec_kwargs, options, q))
+    p.start()
+    out = q.get()
+    p.join()
+    return out
+
+
+def save(name: str, data) -> Path:
+    RESULTS.mkdir(exist_ok=True)
+    path = RESULTS / name
+    path.write_text(json.dumps(data, indent=2, default=str) + "\n")
+    return path
+
+
+def log(msg: str) -> None:
+    print(msg, flush=True)
+    sys.stdout.flush()

@@ -1,0 +1,82 @@
+"""Stability map of the EHL solver: converged / failed over Moes M and L.
+
+    .venv/bin/python bench/stability_map.py [--grid 257] [--jobs 2]
+
+Each point is an SI contact realising (M, L) (ehl_precalc.formulas.contact_from_moes, steel
+on steel, Roelands + Dowson-Higginson) solved from scratch on one grid. A point is
+'converged' when the residual and load tolerances were met; it records hc / NVM and, when
+it failed, why. Writes bench/results/stability_map.{json,png}.
+"""
+
+from __future__ import annotations
+
+import argparse
+from concurrent.futures import ThreadPoolExecutor
+
+
+from common import RESULTS, log, save, solve_in_subprocess
+from ehl_precalc.formulas import contact_from_moes
+
+M_VALUES = [10, 30, 100, 300, 1000, 3000, 10000, 30000]
+L_VALUES = [0, 2, 5, 10, 20]
+
+
+def point(M: float, L: float, grid: int) -> dict:
+    c = contact_from_moes(M, L)
+    spec = dict(load=c.load, speed=c.speed, radius=c.radius, modulus=c.modulus,
+                lubricant="custom", eta0=c.eta0, alpha=c.alpha, rho0=870.0, grid=grid)
+    s = solve_in_subprocess(spec)
+    hc_ratio = (s["hc_m"] / s["hc_nvm_m"]) if s.get("hc_nvm_m") and s.get("hc_m") else None
+    row = dict(M=M, L=L, converged=bool(s["converged"]), residual=s.get("residual"),
+               load_error=s.get("load_error"), cycles=s.get("cycles"), wall_s=s["wall_s"],
+               hc_over_nvm=hc_ratio, hmin_positive=(s.get("hmin_m") or -1) > 0,
+               failure=s.get("failure"), continuation=s.get("continuation_M"))
+    log(f"M={M:>6g} L={L:>4g}: converged={row['converged']!s:5} cycles={row['cycles']} "
+        f"res={row['residual']} hc/NVM={hc_ratio} wall={row['wall_s']:.1f}s {row['failure'] or ''}")
+    return row
+
+
+def plot(rows: list[dict], grid: int) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 5))
+    for r in rows:
+        ok = r["converged"]
+        mark = "o" if ok and r["hmin_positive"] else ("s" if ok else "x")
+        color = "tab:green" if ok and r["hmin_positive"] else ("tab:orange" if ok else "tab:red")
+        ax.scatter(r["M"], r["L"], marker=mark, c=color, s=70)
+        if r["hc_over_nvm"] is not None:
+            ax.annotate(f"{r['hc_over_nvm']:.2f}", (r["M"], r["L"]), textcoords="offset points",
+                        xytext=(6, 4), fontsize=7)
+    ax.set_xscale("log")
+    ax.set_xlabel("Moes M")
+    ax.set_ylabel("Moes L")
+    ax.set_title(f"EHL solver stability, grid {grid}: o converged, s converged but hmin <= 0 "
+                 "(under-resolved), x failed; labels hc/NVM", fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(RESULTS / "stability_map.png", dpi=120)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--grid", type=int, default=257)
+    ap.add_argument("--jobs", type=int, default=2)
+    args = ap.parse_args()
+    pts = [(M, L) for L in L_VALUES for M in M_VALUES]
+    with ThreadPoolExecutor(args.jobs) as ex:
+        rows = list(ex.map(lambda ml: point(ml[0], ml[1], args.grid), pts))
+    save("stability_map.json", {"grid": args.grid, "points": rows})
+    plot(rows, args.grid)
+    ok = sum(r["converged"] for r in rows)
+    log(f"{ok}/{len(rows)} converged; map in {RESULTS / 'stability_map.png'}")
+    fails = [r for r in rows if not r["converged"]]
+    for r in fails:
+        log(f"  failed M={r['M']} L={r['L']}: {r['failure']}")
+
+
+if __name__ == "__main__":
+    main()
