@@ -14,6 +14,8 @@ import numpy as np
 #: Roelands reference constants (Roelands 1966): eta_inf = 6.31e-5 Pa s (ln -> -9.67), p0.
 ROELANDS_LN_ETA_INF = -9.67
 ROELANDS_P0_PA = 1.96e8
+#: Largest ln(eta / eta0) evaluated (see PressureLaws.eta).
+ETA_LN_CAP = 300.0
 #: Dowson-Higginson density constants (Pa).
 DH_A_PA = 5.9e8
 DH_B = 1.34
@@ -92,9 +94,13 @@ class PressureLaws:
         p = np.maximum(P, 0.0) * self.p_hertz
         lub = self.lubricant
         if self.viscosity == "barus":
-            return np.exp(lub.alpha * p)
-        a = np.log(lub.eta0) - ROELANDS_LN_ETA_INF
-        return np.exp(a * ((1.0 + p / ROELANDS_P0_PA) ** lub.roelands_z - 1.0))
+            ln_eta = lub.alpha * p
+        else:
+            a = np.log(lub.eta0) - ROELANDS_LN_ETA_INF
+            ln_eta = a * ((1.0 + p / ROELANDS_P0_PA) ** lub.roelands_z - 1.0)
+        # beyond e^300 the Poiseuille term is zero to machine precision anyway; the cap keeps
+        # an intermediate pressure overshoot from turning into inf * 0 = nan
+        return np.exp(np.minimum(ln_eta, ETA_LN_CAP))
 
     def rho(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(rho / rho0, d(rho/rho0)/dP) at dimensionless pressure P."""

@@ -65,7 +65,7 @@ class SolverOptions:
     fmg_cycles: int = 2
     max_cycles: int = 60
     tol_residual: float = 3e-5
-    tol_load: float = 1e-5
+    tol_load: float = 3e-5
 
 
 @dataclass

@@ -13,6 +13,7 @@ import numpy as np
 from .formulas import Contact, moes_to_hertz_film, nijenbanning_moes_hc
 from .multigrid import Domain, MGResult, MultigridSolver, Problem, SolverOptions
 from .spec import P_AMBIENT_PA, PrecalcSpec
+from .twophase import SubAmbientResult, solve_subambient
 
 #: Above this Moes M (or when a direct start fails) the solve starts from a solution at a
 #: lower M (speed ramp).
@@ -48,6 +49,7 @@ class PrecalcResult:
     mg: MGResult
     wall_s: float
     continuation: list
+    subambient: SubAmbientResult | None = None
 
     @property
     def converged(self) -> bool:
@@ -61,16 +63,16 @@ class PrecalcResult:
         j, i = self.centre_index()
         return float(self.mg.H[j, i])
 
-    def cavity_length_over_a(self) -> float:
-        """Length of the sub-ambient region behind the contact on y = 0, from x = a (units a)."""
+    def cavity_length_over_a(self, below: float = 0.0) -> float:
+        """Length (units a) of the region behind the contact on y = 0 where the gauge
+        pressure is below ``below`` [Pa], from x = a to its downstream end."""
         j, _ = self.centre_index()
-        x, p = self.mg.x, self.mg.P[j]
-        behind = x >= 1.0
-        neg = np.where(behind & (p < 0.0))[0]
+        x, p = self.mg.x, self.mg.P[j] * self.contact.p_hertz
+        neg = np.where((x >= 1.0) & (p < below))[0]
         if neg.size == 0:
             return 0.0
         end = neg[0]
-        while end + 1 < len(x) and p[end + 1] < 0.0:
+        while end + 1 < len(x) and p[end + 1] < below:
             end += 1
         return float(x[end] - 1.0)
 
@@ -106,6 +108,13 @@ class PrecalcResult:
         }
         if self.spec.cavitation == "twophase":
             out["cavity_length_over_a"] = self.cavity_length_over_a()
+            out["cavity_reaches_outlet"] = bool(self.cavity_length_over_a()
+                                                >= self.domain.x_max - 1.0 - self.domain.h)
+            # where more than half the mixture's volume is gas (rho < rho0 / 2)
+            out["cavity_half_density_length_over_a"] = self.cavity_length_over_a(
+                -0.5 * self.spec.twophase_p_scale)
+            if self.subambient is not None:
+                out["subambient_newton_iterations"] = self.subambient.iterations
         return out
 
 
@@ -132,6 +141,10 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
     def h0_guess(M: float) -> float:
         return moes_to_hertz_film(nijenbanning_moes_hc(M, max(c.L, 1e-9)), M) - 1.0
 
+    if twophase:
+        # the contact first, p >= 0 on the two-phase domain; then the sub-ambient field
+        prob = replace(prob, p_floor=0.0, laws=replace(prob.laws, twophase_p_scale=None))
+        solver.prob = prob
     ramp: list[float] = []
     result = None
     if c.M <= CONTINUATION_M:
@@ -150,5 +163,15 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
             if not np.all(np.isfinite(result.P)):
                 break
             P, H0 = result.P, result.H0
+    subambient = None
+    if twophase and np.all(np.isfinite(result.P)):
+        subambient = solve_subambient(result.P, result.H, dom.h,
+                                      replace(prob, p_floor=p_floor, laws=spec.laws()))
+        result.P = subambient.P
+        if not subambient.converged:
+            result.converged = False
+            result.failure = (f"sub-ambient Newton not converged after {subambient.iterations} "
+                              f"iterations (residual {subambient.residual:.3g})")
     return PrecalcResult(spec=spec, contact=c, domain=dom, mg=result,
-                         wall_s=time.perf_counter() - t0, continuation=ramp)
+                         wall_s=time.perf_counter() - t0, continuation=ramp,
+                         subambient=subambient)

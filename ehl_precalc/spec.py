@@ -68,7 +68,7 @@ class PrecalcSpec(BaseModel):
     grid: int | None = None
     max_cycles: int = Field(60, ge=1, le=1000)
     tol_residual: float = Field(3e-5, gt=0.0, lt=1.0)
-    tol_load: float = Field(1e-5, gt=0.0, lt=1.0)
+    tol_load: float = Field(3e-5, gt=0.0, lt=1.0)
 
     @field_validator("grid")
     @classmethod
