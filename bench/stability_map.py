@@ -3,9 +3,11 @@
     .venv/bin/python bench/stability_map.py [--grid 257] [--jobs 2]
 
 Each point is an SI contact realising (M, L) (ehl_precalc.formulas.contact_from_moes, steel
-on steel, Roelands + Dowson-Higginson) solved from scratch on one grid. A point is
-'converged' when the residual and load tolerances were met; it records hc / NVM and, when
-it failed, why. Writes bench/results/stability_map.{json,png}.
+on steel) with Barus viscosity and an incompressible oil, the laws under which the problem
+depends on M and L only, solved from scratch on one grid. A point is 'converged' when the
+residual and load tolerances were met, 'stagnated' when the cycles stalled within ten times
+the tolerance, 'failed' otherwise (diverged or far from converged); it records hc / NVM and
+the reason. Writes bench/results/stability_map.{json,png}.
 """
 
 from __future__ import annotations
@@ -24,14 +26,18 @@ L_VALUES = [0, 2, 5, 10, 20]
 def point(M: float, L: float, grid: int) -> dict:
     c = contact_from_moes(M, L)
     spec = dict(load=c.load, speed=c.speed, radius=c.radius, modulus=c.modulus,
-                lubricant="custom", eta0=c.eta0, alpha=c.alpha, rho0=870.0, grid=grid)
+                lubricant="custom", eta0=c.eta0, alpha=c.alpha, rho0=870.0, grid=grid,
+                viscosity="barus", density="incompressible")
     s = solve_in_subprocess(spec)
     hc_ratio = (s["hc_m"] / s["hc_nvm_m"]) if s.get("hc_nvm_m") and s.get("hc_m") else None
-    row = dict(M=M, L=L, converged=bool(s["converged"]), residual=s.get("residual"),
+    res = s.get("residual")
+    status = ("converged" if s["converged"] else
+              "stagnated" if res is not None and res < 10 * 3e-5 else "failed")
+    row = dict(M=M, L=L, status=status, converged=bool(s["converged"]), residual=res,
                load_error=s.get("load_error"), cycles=s.get("cycles"), wall_s=s["wall_s"],
                hc_over_nvm=hc_ratio, hmin_positive=(s.get("hmin_m") or -1) > 0,
                failure=s.get("failure"), continuation=s.get("continuation_M"))
-    log(f"M={M:>6g} L={L:>4g}: converged={row['converged']!s:5} cycles={row['cycles']} "
+    log(f"M={M:>6g} L={L:>4g}: {status:10} cycles={row['cycles']} "
         f"res={row['residual']} hc/NVM={hc_ratio} wall={row['wall_s']:.1f}s {row['failure'] or ''}")
     return row
 
@@ -43,19 +49,21 @@ def plot(rows: list[dict], grid: int) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(8, 5))
+    style = {"converged": ("o", "tab:green"), "stagnated": ("s", "tab:orange"),
+             "failed": ("x", "tab:red")}
     for r in rows:
-        ok = r["converged"]
-        mark = "o" if ok and r["hmin_positive"] else ("s" if ok else "x")
-        color = "tab:green" if ok and r["hmin_positive"] else ("tab:orange" if ok else "tab:red")
-        ax.scatter(r["M"], r["L"], marker=mark, c=color, s=70)
+        mark, color = style[r["status"]]
+        ax.scatter(r["M"], r["L"], marker=mark, c=color, s=70,
+                   facecolors=color if r["hmin_positive"] else "none")
         if r["hc_over_nvm"] is not None:
             ax.annotate(f"{r['hc_over_nvm']:.2f}", (r["M"], r["L"]), textcoords="offset points",
                         xytext=(6, 4), fontsize=7)
     ax.set_xscale("log")
     ax.set_xlabel("Moes M")
     ax.set_ylabel("Moes L")
-    ax.set_title(f"EHL solver stability, grid {grid}: o converged, s converged but hmin <= 0 "
-                 "(under-resolved), x failed; labels hc/NVM", fontsize=8)
+    ax.set_title(f"EHL solver, grid {grid}, Barus + incompressible: o converged, s stagnated "
+                 "(< 10 x tol), x failed; hollow: hmin <= 0 (under-resolved); labels hc/NVM",
+                 fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(RESULTS / "stability_map.png", dpi=120)
@@ -71,11 +79,12 @@ def main() -> None:
         rows = list(ex.map(lambda ml: point(ml[0], ml[1], args.grid), pts))
     save("stability_map.json", {"grid": args.grid, "points": rows})
     plot(rows, args.grid)
-    ok = sum(r["converged"] for r in rows)
-    log(f"{ok}/{len(rows)} converged; map in {RESULTS / 'stability_map.png'}")
-    fails = [r for r in rows if not r["converged"]]
-    for r in fails:
-        log(f"  failed M={r['M']} L={r['L']}: {r['failure']}")
+    for st in ("converged", "stagnated", "failed"):
+        log(f"{st}: {sum(r['status'] == st for r in rows)}/{len(rows)}")
+    for r in rows:
+        if r["status"] != "converged":
+            log(f"  {r['status']} M={r['M']} L={r['L']}: {r['failure']}")
+    log(f"map in {RESULTS / 'stability_map.png'}")
 
 
 if __name__ == "__main__":

@@ -76,7 +76,7 @@ def _jacobian(P, H, rho, drho, eps, h, unknown):
 
 
 def solve_subambient(P0: np.ndarray, H: np.ndarray, h: float, prob: Problem,
-                     p_fixed: float = 1e-3, tol: float = 1e-8, max_iter: int = 60) -> SubAmbientResult:
+                     p_fixed: float = 1e-3, tol: float = 1e-8, max_iter: int = 200) -> SubAmbientResult:
     """Newton solve of the sub-ambient pressure with the pressurised zone and the film held.
 
     Args:
