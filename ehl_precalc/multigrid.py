@@ -21,6 +21,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.ndimage import minimum_filter
 
 from .elastic import Deformation, hertz_pressure
 from .lubricant import PressureLaws
@@ -102,18 +103,20 @@ class Level:
     def film(self, P: np.ndarray, H0: float) -> np.ndarray:
         return H0 + self.rigid + self.deform(P) + self.tauW
 
-    def coefficients(self, P: np.ndarray, H0: float, prob: Problem):
-        H = self.film(P, H0)
+    def coefficients(self, P: np.ndarray, H0: float, prob: Problem, H: np.ndarray | None = None):
+        """(H, rho, drho, eps) at pressure P; the film is computed unless given."""
+        if H is None:
+            H = self.film(P, H0)
         rho, drho = prob.laws.rho(P)
         eta = prob.laws.eta(P)
         eps = rho * np.maximum(H, 0.0) ** 3 / (eta * prob.lam)
         return H, rho, drho, eps
 
     def residual(self, P: np.ndarray, H0: float, prob: Problem, f: np.ndarray | None = None,
-                 raw: bool = False):
+                 raw: bool = False, H: np.ndarray | None = None):
         """(r, wedge, H) with r = f - L(P); unless ``raw``, r is zeroed where cavitation
         holds (P = 0, r > 0: the diverging gap would pull P below 0)."""
-        H, rho, _, eps = self.coefficients(P, H0, prob)
+        H, rho, _, eps = self.coefficients(P, H0, prob, H)
         r = np.zeros_like(P)
         wedge = np.zeros_like(P)
         residual(P, rho * H, eps, self.f if f is None else f, self.h, self.h, r, wedge)
@@ -142,12 +145,8 @@ def _restrict_pressure(P: np.ndarray, p_floor: float) -> np.ndarray:
     injection near the cavitation boundary and the domain boundary (keeps P >= 0 sharp)."""
     Pc = P[::2, ::2].copy()
     fw = _restrict_full_weighting(P)
-    pos = P > p_floor
-    allpos = np.zeros_like(Pc, dtype=bool)
-    allpos[1:-1, 1:-1] = (
-        pos[2:-2:2, 2:-2:2] & pos[2:-2:2, 1:-3:2] & pos[2:-2:2, 3:-1:2] & pos[1:-3:2, 2:-2:2]
-        & pos[3:-1:2, 2:-2:2] & pos[1:-3:2, 1:-3:2] & pos[1:-3:2, 3:-1:2] & pos[3:-1:2, 1:-3:2]
-        & pos[3:-1:2, 3:-1:2])
+    allpos = minimum_filter(P > p_floor, size=3, mode="constant", cval=False)[::2, ::2]
+    allpos[[0, -1], :] = allpos[:, [0, -1]] = False
     Pc[allpos] = fw[allpos]
     return Pc
 
@@ -226,14 +225,14 @@ class MultigridSolver:
         opt, prob = self.opt, self.prob
         for _ in range(opt.nu1):
             lv.relax(self.H0, prob, opt)
-        r, _, _ = lv.residual(lv.P, self.H0, prob)
+        r, _, H = lv.residual(lv.P, self.H0, prob)
         P_hat = _restrict_pressure(lv.P, prob.p_floor)
         co.P = P_hat.copy()
-        Wf = lv.deform(lv.P) + lv.tauW
-        co.tauW = np.zeros_like(P_hat)
-        co.tauW = Wf[::2, ::2] - co.deform(P_hat)
+        # film FAS correction: the coarse film of P_hat is the fine film at the coarse points
+        H_hat = H[::2, ::2]
+        co.tauW = H_hat - self.H0 - co.rigid - co.deform(P_hat)
         zero_f = np.zeros_like(P_hat)
-        r_hat, _, _ = co.residual(P_hat, self.H0, prob, f=zero_f, raw=True)  # = -L_H(P_hat)
+        r_hat, _, _ = co.residual(P_hat, self.H0, prob, f=zero_f, raw=True, H=H_hat)  # -L_H(P_hat)
         co.f = -r_hat + _restrict_full_weighting(r)
         co.load_target = lv.load_target + co.load(P_hat) - lv.load(lv.P)
         for _ in range(opt.gamma if k > 1 else 1):

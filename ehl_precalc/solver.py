@@ -107,9 +107,9 @@ class PrecalcResult:
             "spec": self.spec.model_dump(),
         }
         if self.spec.cavitation == "twophase":
-            out["cavity_length_over_a"] = self.cavity_length_over_a()
-            out["cavity_reaches_outlet"] = bool(self.cavity_length_over_a()
-                                                >= self.domain.x_max - 1.0 - self.domain.h)
+            length = self.cavity_length_over_a()
+            out["cavity_length_over_a"] = length
+            out["cavity_reaches_outlet"] = bool(length >= self.domain.x_max - 1.0 - self.domain.h)
             # where more than half the mixture's volume is gas (rho < rho0 / 2)
             out["cavity_half_density_length_over_a"] = self.cavity_length_over_a(
                 -0.5 * self.spec.twophase_p_scale)
