@@ -118,6 +118,14 @@ class PrecalcResult:
         return out
 
 
+def _worse(a: MGResult, b: MGResult) -> bool:
+    """Whether attempt ``a`` is worse than ``b``: non-finite, or unconverged with a larger
+    residual."""
+    if not np.all(np.isfinite(a.P)) or not np.isfinite(a.residual):
+        return True
+    return not a.converged and a.residual > b.residual
+
+
 def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcResult:
     """Solve the EHL contact of ``spec``.
 
@@ -146,9 +154,9 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
         prob = replace(prob, p_floor=0.0, laws=replace(prob.laws, twophase_p_scale=None))
         solver.prob = prob
     ramp: list[float] = []
-    result = None
+    direct = result = None
     if c.M <= CONTINUATION_M:
-        result = solver.solve(h0_guess(c.M))
+        direct = result = solver.solve(h0_guess(c.M))
     if result is None or not result.converged:
         steps = max(1, math.ceil(math.log2(c.M / min(c.M, CONTINUATION_M / 4))))
         M_start = c.M / 2**steps
@@ -163,6 +171,8 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
             if not np.all(np.isfinite(result.P)):
                 break
             P, H0 = result.P, result.H0
+        if direct is not None and _worse(result, direct):
+            result, ramp = direct, []  # the ramp did not help: keep the direct attempt
     subambient = None
     if twophase and np.all(np.isfinite(result.P)):
         subambient = solve_subambient(result.P, result.H, dom.h,
