@@ -238,7 +238,8 @@ class MultigridSolver:
         for _ in range(opt.gamma if k > 1 else 1):
             self._cycle(k - 1)
         corr = _prolong_bilinear(co.P - P_hat)
-        corr[lv.P <= prob.p_floor] = 0.0  # no correction inside the cavitated region
+        # no correction inside the cavitated region, nor on its boundary
+        corr[~minimum_filter(lv.P > prob.p_floor, size=3, mode="constant", cval=False)] = 0.0
         lv.P += corr
         self._enforce_bc(lv)
         for _ in range(opt.nu2):
