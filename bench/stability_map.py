@@ -13,6 +13,7 @@ the reason. Writes bench/results/stability_map.{json,png}.
 from __future__ import annotations
 
 import argparse
+import json
 from concurrent.futures import ThreadPoolExecutor
 
 
@@ -53,8 +54,9 @@ def plot(rows: list[dict], grid: int) -> None:
              "failed": ("x", "tab:red")}
     for r in rows:
         mark, color = style[r["status"]]
-        ax.scatter(r["M"], r["L"], marker=mark, c=color, s=70,
-                   facecolors=color if r["hmin_positive"] else "none")
+        filled = r["hmin_positive"] or mark == "x"
+        ax.scatter(r["M"], r["L"], marker=mark, s=70, edgecolors=color,
+                   facecolors=color if filled else "none")
         if r["hc_over_nvm"] is not None:
             ax.annotate(f"{r['hc_over_nvm']:.2f}", (r["M"], r["L"]), textcoords="offset points",
                         xytext=(6, 4), fontsize=7)
@@ -73,7 +75,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--grid", type=int, default=257)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--replot", action="store_true", help="only redraw the saved map")
     args = ap.parse_args()
+    if args.replot:
+        data = json.loads((RESULTS / "stability_map.json").read_text())
+        plot(data["points"], data["grid"])
+        return
     pts = [(M, L) for L in L_VALUES for M in M_VALUES]
     with ThreadPoolExecutor(args.jobs) as ex:
         rows = list(ex.map(lambda ml: point(ml[0], ml[1], args.grid), pts))
