@@ -16,7 +16,8 @@ import numpy as np
 from .solver import PrecalcResult
 
 
-def _atomic_write(path: Path, write) -> None:
+def atomic_write(path: Path, write) -> None:
+    """Write ``path`` through ``write(binary file)`` to a temporary sibling, then rename it."""
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as fh:
@@ -27,21 +28,30 @@ def _atomic_write(path: Path, write) -> None:
         raise
 
 
-def _finite_or_none(value):
+def finite_or_none(value):
     """JSON has no NaN/inf: a blown-up run reports null."""
     if isinstance(value, float) and not np.isfinite(value):
         return None
     if isinstance(value, dict):
-        return {k: _finite_or_none(v) for k, v in value.items()}
+        return {k: finite_or_none(v) for k, v in value.items()}
     if isinstance(value, list):
-        return [_finite_or_none(v) for v in value]
+        return [finite_or_none(v) for v in value]
     return value
 
 
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write ``text`` (UTF-8) atomically."""
+    atomic_write(Path(path), lambda fh: fh.write(text.encode()))
+
+
+def atomic_write_json(path: Path, data) -> None:
+    """Write ``data`` as indented JSON atomically; NaN and inf become null."""
+    atomic_write_text(path, json.dumps(finite_or_none(data), indent=2, allow_nan=False) + "\n")
+
+
 def write_summary(result: PrecalcResult, out: Path) -> dict:
-    summary = _finite_or_none(result.summary())
-    _atomic_write(out / "summary.json",
-                  lambda fh: fh.write(json.dumps(summary, indent=2, allow_nan=False).encode() + b"\n"))
+    summary = finite_or_none(result.summary())
+    atomic_write_json(out / "summary.json", summary)
     return summary
 
 
@@ -50,7 +60,7 @@ def write_solution(result: PrecalcResult, out: Path) -> None:
     c, mg = result.contact, result.mg
     arrays = dict(x=mg.x * c.a, y=mg.y * c.a, p=mg.P * c.p_hertz, h=mg.H * c.film_scale,
                   a_m=c.a, radius_m=c.radius, p_hertz_Pa=c.p_hertz, h0_m=mg.H0 * c.film_scale)
-    _atomic_write(out / "solution.npz", lambda fh: np.savez_compressed(fh, **arrays))
+    atomic_write(out / "solution.npz", lambda fh: np.savez_compressed(fh, **arrays))
 
 
 def write_plot(result: PrecalcResult, out: Path) -> None:
@@ -75,7 +85,9 @@ def write_plot(result: PrecalcResult, out: Path) -> None:
         a2 = a1.twinx()
         a2.plot(coord, h_line, "C1")
         a2.set_ylabel("h [nm]", color="C1")
-        a2.set_ylim(0, 5 * result.H_central * c.film_scale * 1e9)
+        top = 5 * result.H_central * c.film_scale * 1e9
+        if np.isfinite(top) and top > 0:  # a failed solution still gets its plot
+            a2.set_ylim(0, top)
     ext = [mg.x[0], mg.x[-1], mg.y[0], mg.y[-1]]
     im = ax[1, 0].imshow(p_gpa, origin="lower", extent=ext, cmap="viridis")
     fig.colorbar(im, ax=ax[1, 0], label="p [GPa]")
@@ -93,7 +105,7 @@ def write_plot(result: PrecalcResult, out: Path) -> None:
         f"L = {c.L:.2f}, hc = {hc:.2f} nm, hmin = {mg.H.min() * c.film_scale * 1e9:.2f} nm, "
         f"grid {result.domain.nx}x{result.domain.ny}, converged = {result.converged}")
     fig.tight_layout()
-    _atomic_write(out / "precalc.png", lambda fh: fig.savefig(fh, format="png", dpi=110))
+    atomic_write(out / "precalc.png", lambda fh: fig.savefig(fh, format="png", dpi=110))
     plt.close(fig)
 
 

@@ -126,6 +126,25 @@ def _worse(a: MGResult, b: MGResult) -> bool:
     return not a.converged and a.residual > b.residual
 
 
+def _ramp(solver, prob, opt, c, factor: float, start: float, h0_guess):
+    """Step M up by ``factor`` from at most ``start`` to the contact's M, each step from the
+    previous pressure and film constant; returns the M values and the last result."""
+    steps = max(1, math.ceil(math.log(c.M / min(c.M, start)) / math.log(factor) - 1e-9))
+    M_start = c.M / factor**steps
+    ramp = [M_start * factor**k for k in range(steps + 1)]
+    P, H0, result = None, h0_guess(M_start), None
+    for k, M_k in enumerate(ramp):
+        lam_k = c.lam * (M_k / c.M) ** (-4.0 / 3.0)  # M ~ u^-3/4 at fixed load
+        solver.prob = replace(prob, lam=lam_k, moes_M=M_k)
+        solver.opt = opt if k == steps else replace(opt, max_cycles=RAMP_CYCLES)
+        result = solver.solve(H0, P_init=P)
+        if not np.all(np.isfinite(result.P)):
+            break
+        P, H0 = result.P, result.H0
+    solver.opt = opt
+    return ramp, result
+
+
 def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcResult:
     """Solve the EHL contact of ``spec``.
 
@@ -158,19 +177,15 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
     if c.M <= CONTINUATION_M:
         direct = result = solver.solve(h0_guess(c.M))
     if result is None or not result.converged:
-        steps = max(1, math.ceil(math.log2(c.M / min(c.M, CONTINUATION_M / 4))))
-        M_start = c.M / 2**steps
-        ramp = [M_start * 2**k for k in range(steps + 1)]
-        P = None
-        H0 = h0_guess(M_start)
-        for k, M_k in enumerate(ramp):
-            lam_k = c.lam * (M_k / c.M) ** (-4.0 / 3.0)  # M ~ u^-3/4 at fixed load
-            solver.prob = replace(prob, lam=lam_k, moes_M=M_k)
-            solver.opt = opt if k == steps else replace(opt, max_cycles=RAMP_CYCLES)
-            result = solver.solve(H0, P_init=P)
-            if not np.all(np.isfinite(result.P)):
+        # a ramp by factors of 2 from M <= CONTINUATION_M / 4; if it blows up, a gentler one
+        # (factors of sqrt 2 from M <= CONTINUATION_M / 8)
+        for factor, start in ((2.0, CONTINUATION_M / 4), (math.sqrt(2.0), CONTINUATION_M / 8)):
+            solver = MultigridSolver(prob, dom, opt)  # fresh: no state of a failed attempt
+            ramp, attempt = _ramp(solver, prob, opt, c, factor, start, h0_guess)
+            if result is None or not _worse(attempt, result):
+                result = attempt
+            if attempt.converged:
                 break
-            P, H0 = result.P, result.H0
         if direct is not None and _worse(result, direct):
             result, ramp = direct, []  # the ramp did not help: keep the direct attempt
     subambient = None
