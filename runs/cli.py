@@ -3,6 +3,8 @@
 Subcommands:
   doctor   show the OpenFOAM runtime and check its build (pitzDaily test)
   precalc  the EHL pre-calculation, registered by ``ehl_precalc.cli``
+  case     write an OpenFOAM case from a TOML case spec
+  run      run a case to steady state and write its metrics.json
 
 Exit codes: 0 ok, 1 failure, 2 bad input.
 """
@@ -39,6 +41,72 @@ def cmd_doctor(args: argparse.Namespace) -> int:
     return EXIT_OK if result.ok else EXIT_FAILURE
 
 
+def cmd_case(args: argparse.Namespace) -> int:
+    """Validate the spec, then build the case (precalc, mesh, OpenFOAM files)."""
+    from ehl_precalc.spec import SpecError
+    from generator.case_spec import load_case_spec, make_case_spec
+    from generator.case_writer import CaseExists, write_case
+
+    overrides = dict(kv.split("=", 1) for kv in args.set or [])
+    try:
+        overrides = {k: _parse_value(v) for k, v in overrides.items()}
+        spec = (load_case_spec(args.spec, **overrides) if args.spec
+                else make_case_spec(None, **overrides))
+    except (SpecError, ValueError) as err:
+        print(f"ehlfoam case: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    try:
+        geom = write_case(spec, args.out, overwrite=args.overwrite)
+    except CaseExists as err:
+        print(f"ehlfoam case: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    print(f"case {args.out}: {geom.cells} cells, a = {geom.a * 1e3:.4f} mm, "
+          f"transit {geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, "
+          f"maxDeltaT {geom.max_delta_t:.3g} s ({geom.capillary_limit}), "
+          f"gap mismatch {geom.gap_mismatch:.2%}")
+    return EXIT_OK
+
+
+def _parse_value(text: str):
+    """A --set value: TOML scalar syntax (numbers, booleans, quoted or bare strings)."""
+    import tomllib
+
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    """Run a generated case and print its metrics."""
+    import json
+
+    from runs.run_case import CaseBusy, run_case
+
+    try:
+        metrics = run_case(args.case, wall_limit=args.wall_limit,
+                           on_sample=None if args.quiet else _print_sample)
+    except (CaseBusy, FileNotFoundError) as err:
+        print(f"ehlfoam run: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    keys = ("status", "end_reason", "state", "inlet_meniscus_distance_over_a",
+            "inlet_meniscus_shape", "flooded_length_over_a", "flooded_width_over_a",
+            "wake_gas_length_over_a", "oil_mass_balance_error", "simulated_time_s",
+            "time_steps", "wall_s")
+    print(json.dumps({k: metrics.get(k) for k in keys}))
+    return EXIT_OK if metrics["status"] == "finished" else EXIT_FAILURE
+
+
+def _print_sample(sample, geom) -> None:
+    p = sample.pattern
+    fmt = lambda v: "-" if v is None else f"{v:.2f}"  # noqa: E731
+    print(f"t = {sample.time * 1e3:8.2f} ms ({sample.time / geom.transit_time:5.2f} transits)  "
+          f"state {p.get('state')}  oil {sample.oil_volume * 1e12:9.4f} nl  "
+          f"inlet meniscus {fmt(p.get('inlet_meniscus_distance_over_a'))} a  "
+          f"flooded {fmt(p.get('flooded_length_over_a'))} x {fmt(p.get('flooded_width_over_a'))} a",
+          flush=True)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="ehlfoam",
@@ -57,6 +125,30 @@ def build_parser() -> argparse.ArgumentParser:
     doctor.set_defaults(func=cmd_doctor)
 
     precalc_cli.add_parser(sub)
+
+    case = sub.add_parser(
+        "case", help="write an OpenFOAM case from a case spec (TOML)",
+        description="Validate the case spec, solve (or reuse) its EHL precalc, mesh the gap "
+                    "around the contact and write a complete OpenFOAM case that also runs by "
+                    "hand (DIR/Allrun). Exit 2 on a bad spec, before anything is written.")
+    case.add_argument("spec", nargs="?", help="case spec TOML (default: the reference case)")
+    case.add_argument("--out", required=True, help="case folder to write")
+    case.add_argument("--set", action="append", metavar="KEY=VALUE",
+                      help="override a spec value, e.g. --set contact.speed=0.017 "
+                           "--set mesh.resolution=coarse (repeatable)")
+    case.add_argument("--overwrite", action="store_true", help="replace an existing case")
+    case.set_defaults(func=cmd_case)
+
+    run = sub.add_parser(
+        "run", help="run a case to steady state and write DIR/metrics.json",
+        description="Run interFoam on a generated case, monitor oil volume and menisci from "
+                    "outside, stop at steady state or a limit, write DIR/metrics.json and "
+                    "DIR/history.csv. Exit 1 if the run failed.")
+    run.add_argument("case", help="case folder written by `ehlfoam case`")
+    run.add_argument("--wall-limit", type=float, default=None,
+                     help="wall-clock limit [s] (default: the spec's run.wall_limit)")
+    run.add_argument("--quiet", action="store_true", help="no line per written time")
+    run.set_defaults(func=cmd_run)
     return parser
 
 

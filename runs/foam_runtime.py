@@ -254,6 +254,33 @@ class FoamRuntime:
                 "EHLFOAM_FOAM=native but no OpenFOAM application (blockMesh) is on PATH. "
                 + _SETUP_HINT)
 
+    # ----------------------------------------------------------------- start
+    def popen(
+        self,
+        app: str,
+        args: Sequence[str | os.PathLike[str]] = (),
+        cwd: str | os.PathLike[str] = ".",
+        log_path: str | os.PathLike[str] = "log",
+    ) -> subprocess.Popen:
+        """Start ``app args`` in the case folder ``cwd`` without waiting, stdout and stderr
+        to ``log_path`` (relative to ``cwd``). The caller waits for or stops the process."""
+        self.ensure_present()
+        case = Path(cwd).absolute()
+        if not case.is_dir():
+            raise FoamError(f"{app}: case folder {case} does not exist")
+        if self.kind == "embedded" and not Path(self.app_path(app)).is_file():
+            raise FoamError(f"OpenFOAM application {app!r} not found in the embedded runtime "
+                            f"({self.app_path(app)} does not exist); case {case}")
+        argv = self.command(app, *args)
+        log = case / log_path
+        with open(log, "w", encoding="utf-8", errors="replace") as fh:
+            try:
+                return subprocess.Popen(argv, cwd=case, env=self.env(), stdout=fh,
+                                        stderr=subprocess.STDOUT, start_new_session=True)
+            except FileNotFoundError as exc:
+                raise FoamError(f"{app}: cannot start {argv[0]!r} ({exc.strerror}); "
+                                f"runtime {self.kind}; case {case}") from exc
+
     # ----------------------------------------------------------------- run
     def run(
         self,

@@ -1,0 +1,347 @@
+"""The case spec: one validated description of an OpenFOAM case around the contact.
+
+A TOML file with the tables below; every key is optional and defaults to the reference
+conditions of ``ball_on_disc.md`` (HVI60, 40 C, 20 N, 8 mm/s, ample oil). SI units
+throughout (m, s, N, Pa, kg/m3), except the contact angle in degrees and the domain in
+units of the Hertzian radius a::
+
+    [contact]            # the EHL precalc spec (ehl_precalc.spec.PrecalcSpec), e.g.
+    load = 20.0          # N
+    speed = 0.008        # m/s, pure rolling
+    temperature = 40.0   # C
+    lubricant = "HVI60"
+
+    [supply]
+    mode = "layers"      # "flooded" (ample oil) or "layers"
+    disc_layer = 2e-6    # m, oil layer carried into the inlet on the disc
+    ball_layer = 2e-6    # m, ... on the ball
+    track_half_width = 3e-4   # m
+
+    [physics]            # assumed values of the reference
+    surface_tension = 0.030
+    contact_angle = 15.0 # degrees, disc, ball and island
+    ...
+
+    [domain]             # units of a
+    upstream = 8.0
+    ...
+
+    [mesh]
+    resolution = "medium"   # coarse | medium | fine
+
+    [run]
+    ...
+
+Validation happens once, in :func:`make_case_spec`; errors name the parameter, its value and
+its valid range, before anything is written.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ehl_precalc.spec import PrecalcSpec, SpecError
+
+_STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+#: In-plane cell size at the island rim and far away (units a), and cells across the gap.
+RESOLUTIONS: dict[str, dict[str, float]] = {
+    "coarse": {"size_rim": 0.12, "size_far": 0.8, "n_layers": 4},
+    "medium": {"size_rim": 0.08, "size_far": 0.55, "n_layers": 6},
+    "fine": {"size_rim": 0.055, "size_far": 0.38, "n_layers": 8},
+}
+
+
+class Supply(BaseModel):
+    """Oil reaching the contact.
+
+    Attributes:
+        mode: "flooded": the whole gap height on the track is oil at the inlet and the case
+            starts from a puddle (ample oil); "layers": an oil layer on each surface, on the
+            track only, is carried in by the walls (a starved supply).
+        disc_layer, ball_layer: oil layer thickness on the disc and on the ball at the
+            inlet [m] ("layers" mode).
+        track_half_width: half-width of the oil track at the inlet [m].
+        initial_puddle: radius of the oil puddle around the contact at t = 0, units of a
+            (0: none).
+    """
+
+    model_config = _STRICT
+    mode: Literal["flooded", "layers"] = "flooded"
+    disc_layer: float = Field(2e-6, ge=0.0, le=1e-3)
+    ball_layer: float = Field(2e-6, ge=0.0, le=1e-3)
+    track_half_width: float = Field(3e-4, gt=0.0, le=0.1)
+    initial_puddle: float = Field(4.0, ge=0.0, le=100.0)
+
+
+class Physics(BaseModel):
+    """Fluid properties and wetting (the reference's assumed values by default).
+
+    Attributes:
+        surface_tension: oil-air surface tension [N/m].
+        contact_angle: static contact angle of oil on steel and glass [deg].
+        oil_density: [kg/m3]; None takes the lubricant's rho0.
+        air_density [kg/m3], air_viscosity [Pa s].
+        viscosity_factor: multiplies the oil viscosity (and divides nothing else); 3 turns
+            a one-cell-thick gap into Reynolds flow (used by the single-phase check only).
+    """
+
+    model_config = _STRICT
+    surface_tension: float = Field(0.030, gt=0.0, le=1.0)
+    contact_angle: float = Field(15.0, ge=0.0, le=180.0)
+    oil_density: float | None = Field(None, gt=0.0, le=1e4)
+    air_density: float = Field(1.2, gt=0.0, le=100.0)
+    air_viscosity: float = Field(1.8e-5, gt=0.0, le=1.0)
+    viscosity_factor: float = Field(1.0, gt=0.0, le=1e3)
+
+
+class Domain(BaseModel):
+    """Extents around the contact centre, units of the Hertzian radius a.
+
+    Attributes:
+        upstream: distance to the inlet boundary (x = -upstream a).
+        downstream: distance to the outlet boundary.
+        side: distance to the side boundary (|y| = side a).
+        island_radius: radius of the island wall that replaces the Hertzian contact
+            (not meshed); > 1 so that its gap is sub-micron but not nanometric.
+        symmetry: "half" (y >= 0 with a symmetry plane) or "full".
+    """
+
+    model_config = _STRICT
+    upstream: float = Field(8.0, gt=1.0, le=200.0)
+    downstream: float = Field(14.0, gt=1.0, le=200.0)
+    side: float = Field(8.0, gt=1.0, le=200.0)
+    island_radius: float = Field(1.5, gt=1.0, le=10.0)
+    symmetry: Literal["half", "full"] = "half"
+
+    @model_validator(mode="after")
+    def _island_inside(self) -> "Domain":
+        limit = min(self.upstream, self.downstream, self.side)
+        if self.island_radius >= 0.8 * limit:
+            raise ValueError(f"island_radius = {self.island_radius:g} a must stay below 0.8 x "
+                             f"the nearest boundary ({0.8 * limit:g} a)")
+        return self
+
+
+class Mesh(BaseModel):
+    """Resolution level (see :data:`RESOLUTIONS`) and optional overrides.
+
+    Attributes:
+        resolution: "coarse", "medium" or "fine".
+        n_layers: cells across the gap (None: the level's value).
+        size_rim, size_far: in-plane cell size at the island rim / far away, units of a.
+    """
+
+    model_config = _STRICT
+    resolution: Literal["coarse", "medium", "fine"] = "medium"
+    n_layers: int | None = Field(None, ge=1, le=64)
+    size_rim: float | None = Field(None, gt=0.0, le=10.0)
+    size_far: float | None = Field(None, gt=0.0, le=50.0)
+
+    def level(self) -> dict[str, float]:
+        """The level's sizes with the overrides applied."""
+        out = dict(RESOLUTIONS[self.resolution])
+        for key in ("n_layers", "size_rim", "size_far"):
+            if getattr(self, key) is not None:
+                out[key] = getattr(self, key)
+        out["n_layers"] = int(out["n_layers"])
+        return out
+
+
+class Run(BaseModel):
+    """Time stepping, steady-state detection and limits.
+
+    Attributes:
+        end_time: simulated time limit [s]; None: ``transits_max`` transit times.
+        transit_length: the length, units of a, whose transit time L/u is the steady-state
+            window (about the flooded region's size).
+        transits_max: time limit in transit times when end_time is None.
+        steady_tolerance: relative change of the oil volume and of the meniscus positions
+            (units a) over one transit below which the run counts as steady.
+        writes_per_transit: field writes per transit time (what the monitor sees).
+        wall_limit: wall-clock limit [s].
+        max_courant, max_alpha_courant: OpenFOAM's maxCo and maxAlphaCo.
+        capillary_limit: time-step limit for surface tension: "galusinski-vigneaux"
+            (viscous, the one that matters at Re << 1), "brackbill" (inertial, strict) or
+            "none".
+        capillary_safety: factor on that limit.
+        n_procs: MPI ranks (1: serial).
+    """
+
+    model_config = _STRICT
+    end_time: float | None = Field(None, gt=0.0, le=1e3)
+    transit_length: float = Field(10.0, gt=0.0, le=1e3)
+    transits_max: float = Field(4.0, gt=0.0, le=1e3)
+    steady_tolerance: float = Field(0.01, gt=0.0, lt=1.0)
+    writes_per_transit: int = Field(10, ge=2, le=1000)
+    wall_limit: float = Field(3600.0, gt=0.0, le=1e6)
+    max_courant: float = Field(0.5, gt=0.0, le=10.0)
+    max_alpha_courant: float = Field(0.5, gt=0.0, le=10.0)
+    capillary_limit: Literal["galusinski-vigneaux", "brackbill", "none"] = "galusinski-vigneaux"
+    capillary_safety: float = Field(1.0, gt=0.0, le=100.0)
+    n_procs: int = Field(1, ge=1, le=1024)
+
+
+class CaseSpec(BaseModel):
+    """One OpenFOAM case around the EHL contact.
+
+    Attributes:
+        name: label used in reports.
+        scene: "interface": two-phase oil/air, surface tension, no cavitation (interFoam);
+            "single-phase": oil everywhere (the check against the Reynolds solution).
+        contact: the EHL conditions (:class:`ehl_precalc.spec.PrecalcSpec`).
+        walls_moving: False holds both walls still (the static-meniscus test).
+    """
+
+    model_config = _STRICT
+    name: str = "case"
+    scene: Literal["interface", "single-phase"] = "interface"
+    contact: PrecalcSpec = PrecalcSpec(speed=0.008)
+    supply: Supply = Supply()
+    physics: Physics = Physics()
+    domain: Domain = Domain()
+    mesh: Mesh = Mesh()
+    run: Run = Run()
+    walls_moving: bool = True
+
+    # ---- derived quantities: the one place they are computed ---------------------------
+    @property
+    def a(self) -> float:
+        """Hertzian radius [m]."""
+        return self.contact.contact().a
+
+    @property
+    def speed(self) -> float:
+        """Rolling speed u [m/s] (both surfaces)."""
+        return self.contact.speed
+
+    @property
+    def oil_viscosity(self) -> float:
+        """Oil dynamic viscosity at ambient pressure [Pa s], times viscosity_factor."""
+        return self.contact.oil().eta0 * self.physics.viscosity_factor
+
+    @property
+    def oil_density(self) -> float:
+        """[kg/m3]."""
+        return self.physics.oil_density or self.contact.oil().rho0
+
+    @property
+    def transit_time(self) -> float:
+        """transit_length a / u [s]."""
+        return self.run.transit_length * self.a / self.speed
+
+    @property
+    def end_time(self) -> float:
+        """Simulated time limit [s]."""
+        return self.run.end_time or self.run.transits_max * self.transit_time
+
+    def to_toml_dict(self) -> dict[str, Any]:
+        """The spec as plain TOML-able data (None values dropped)."""
+        return _drop_none(self.model_dump())
+
+
+def _drop_none(value):
+    if isinstance(value, dict):
+        return {k: _drop_none(v) for k, v in value.items() if v is not None}
+    return value
+
+
+# ------------------------------------------------------------------ errors
+def _field_at(model: type[BaseModel], loc: tuple) -> tuple[type[BaseModel] | None, Any]:
+    """The model class and field info that a pydantic error location points at."""
+    for i, part in enumerate(loc):
+        field = model.model_fields.get(str(part))
+        if field is None:
+            return model, None
+        ann = field.annotation
+        if i == len(loc) - 1 or not (isinstance(ann, type) and issubclass(ann, BaseModel)):
+            return model, field
+        model = ann
+    return model, None
+
+
+def _range_text(name: str, field) -> str:
+    lo = hi = ""
+    for m in getattr(field, "metadata", []):
+        for attr, fmt in (("gt", "{} < "), ("ge", "{} <= ")):
+            if getattr(m, attr, None) is not None:
+                lo = fmt.format(f"{getattr(m, attr):g}")
+        for attr, fmt in (("lt", " < {}"), ("le", " <= {}")):
+            if getattr(m, attr, None) is not None:
+                hi = fmt.format(f"{getattr(m, attr):g}")
+    return f"valid range {lo}{name}{hi}" if lo or hi else ""
+
+
+def format_errors(err: ValidationError, root: type[BaseModel] = None) -> str:
+    """One line per error: ``parameter = value: problem (valid range ...)``."""
+    root = root or CaseSpec
+    lines = []
+    for e in err.errors():
+        loc = tuple(e["loc"])
+        name = ".".join(str(p) for p in loc) or "spec"
+        msg = e["msg"].removeprefix("Value error, ")
+        model, field = _field_at(root, loc)
+        if e["type"] == "extra_forbidden":
+            valid = ", ".join(model.model_fields) if model else ""
+            lines.append(f"{name}: unknown parameter (valid here: {valid})")
+        elif loc and "input" in e and not isinstance(e["input"], dict):
+            rng = _range_text(name, field) if field is not None else ""
+            lines.append(f"{name} = {e['input']!r}: {msg}" + (f" ({rng})" if rng else ""))
+        else:
+            lines.append(f"{name}: {msg}")
+    return "; ".join(lines)
+
+
+def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> CaseSpec:
+    """Validate a case spec from nested data; ``overrides`` are dotted keys
+    (``{"contact.speed": 0.017}``) applied on top. Raises :class:`SpecError`."""
+    data = _deep_copy(data or {})
+    for dotted, value in overrides.items():
+        if value is None:
+            continue
+        node = data
+        *parents, leaf = dotted.split(".")
+        for p in parents:
+            node = node.setdefault(p, {})
+        node[leaf] = value
+    try:
+        spec = CaseSpec(**data)
+    except ValidationError as err:
+        raise SpecError(f"invalid case spec: {format_errors(err)}") from None
+    except SpecError as err:  # raised by PrecalcSpec's own validators
+        raise SpecError(f"invalid case spec: contact: {err}") from None
+    _check_supply_fits(spec)
+    return spec
+
+
+def _check_supply_fits(spec: CaseSpec) -> None:
+    side = spec.domain.side * spec.a
+    if spec.supply.track_half_width >= side:
+        raise SpecError(
+            f"invalid case spec: supply.track_half_width = {spec.supply.track_half_width:g} m "
+            f"must be smaller than the domain side {spec.domain.side:g} a = {side:g} m")
+    if not math.isfinite(spec.a):
+        raise SpecError("invalid case spec: contact gives a non-finite Hertz radius")
+
+
+def _deep_copy(data):
+    if isinstance(data, dict):
+        return {k: _deep_copy(v) for k, v in data.items()}
+    return data
+
+
+def load_case_spec(path: str | Path, **overrides: Any) -> CaseSpec:
+    """Read and validate a TOML case spec; ``overrides`` as in :func:`make_case_spec`."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise SpecError(f"spec file = {str(path)!r}: no such file") from None
+    except tomllib.TOMLDecodeError as err:
+        raise SpecError(f"spec file = {str(path)!r}: not valid TOML ({err})") from None
+    return make_case_spec(data, **overrides)

@@ -1,0 +1,316 @@
+"""Write a complete OpenFOAM case from a :class:`~generator.case_spec.CaseSpec`.
+
+    spec -> gap (ehl_precalc, cached) -> mesh (gmsh base, extruded on h) -> case
+
+The case is the template folder ``templates/<scene>/`` copied and edited with foamlib (values
+marked "set by the generator" in the templates), the mesh written directly as a polyMesh,
+and ``ehlfoam/`` holding what the monitor and the metrics need (the spec, the geometry, the
+mesh's 2D structure). The case also runs by hand: ``DIR/Allrun``, ``DIR/Allclean``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shlex
+import shutil
+import tempfile
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+from foamlib import FoamFieldFile, FoamFile
+
+from ehl_precalc.outputs import atomic_write_json, atomic_write_text
+from runs.foam_runtime import FoamRuntime
+
+from .case_spec import CaseSpec
+from .gap_source import load_gap
+from .mesh import MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch, write_polymesh
+
+TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
+META = "ehlfoam"  # the case's own folder of generator outputs
+
+#: Galusinski & Vigneaux (2008) constants of the capillary time-step limit.
+GV_C1, GV_C2 = 0.01, 10.0
+
+
+class CaseExists(FileExistsError):
+    """The output folder exists and is not empty."""
+
+
+@dataclass(frozen=True)
+class CaseGeometry:
+    """Numbers of a generated case that the run, the metrics and the reports need (SI)."""
+
+    a: float
+    radius: float
+    speed: float
+    x_min: float
+    x_max: float
+    y_max: float
+    island_radius: float
+    symmetric: bool
+    n_layers: int
+    cells: int
+    transit_time: float
+    end_time: float
+    write_interval: float
+    max_delta_t: float
+    capillary_limit: str
+    min_cell_size: float
+    island_gap: float
+    hc: float
+    contact_flow: float
+    gap_mismatch: float
+    oil_viscosity: float
+    oil_density: float
+
+
+# --------------------------------------------------------------- numbers
+def size_function(spec: CaseSpec):
+    """In-plane cell size [m] at (x, y): size_rim at the island rim, growing in proportion to
+    the distance from the contact centre (the gap grows like r^2, the meniscus sits a few a
+    out), capped at size_far."""
+    level, a, ri = spec.mesh.level(), spec.a, spec.domain.island_radius * spec.a
+    rim, far = level["size_rim"] * a, level["size_far"] * a
+
+    def size(x, y):
+        r = np.hypot(np.asarray(x, float), np.asarray(y, float))
+        return np.clip(rim * r / ri, rim, far)
+
+    return size
+
+
+def capillary_time_step(spec: CaseSpec, dx: float) -> float:
+    """Surface-tension time-step limit [s] for in-plane cells of size dx [m].
+
+    Galusinski-Vigneaux: dt <= 0.5 (c2 mu dx/sigma + sqrt((c2 mu dx/sigma)^2 + 4 c1 rho dx^3/sigma)),
+    with the mean of the two viscosities and densities: its viscous term governs at Re << 1.
+    Brackbill: dt <= sqrt(rho dx^3 / (2 pi sigma)). "none": no limit (inf).
+    """
+    p = spec.physics
+    sigma = p.surface_tension
+    rho = 0.5 * (spec.oil_density + p.air_density)
+    mu = 0.5 * (spec.oil_viscosity + p.air_viscosity)
+    kind = spec.run.capillary_limit
+    if kind == "brackbill":
+        dt = math.sqrt(rho * dx**3 / (2.0 * math.pi * sigma))
+    elif kind == "galusinski-vigneaux":
+        v = GV_C2 * mu * dx / sigma
+        dt = 0.5 * (v + math.sqrt(v * v + 4.0 * GV_C1 * rho * dx**3 / sigma))
+    else:
+        return math.inf
+    return dt * spec.run.capillary_safety
+
+
+def _overlap(lo, hi, a, b):
+    """Length of [lo, hi] inside [a, b] (arrays)."""
+    return np.clip(np.minimum(hi, b) - np.maximum(lo, a), 0.0, None)
+
+
+def oil_fraction(spec: CaseSpec, y, z_lo, z_hi, gap_h, on_track) -> np.ndarray:
+    """Oil fraction of cells or faces spanning z in [z_lo, z_hi] of a column of gap gap_h [m]:
+    the supply layers on the disc and the ball ("layers") or the whole height ("flooded"),
+    only where ``on_track``."""
+    s = spec.supply
+    span = np.maximum(z_hi - z_lo, 1e-300)
+    if s.mode == "flooded":
+        frac = np.ones_like(span)
+    else:
+        disc = _overlap(z_lo, z_hi, 0.0, np.minimum(s.disc_layer, gap_h))
+        ball = _overlap(z_lo, z_hi, np.maximum(gap_h - s.ball_layer, s.disc_layer), gap_h)
+        frac = (disc + ball) / span
+    return np.where(on_track, np.clip(frac, 0.0, 1.0), 0.0)
+
+
+def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
+    """alpha.oil at t = 0: the supply layers on the track and a puddle of radius
+    initial_puddle a around the contact (whole gap height); all oil for single-phase."""
+    if spec.scene == "single-phase":
+        return np.ones(len(mesh.cell_volumes))
+    x, y = mesh.cell_centres[:, 0], mesh.cell_centres[:, 1]
+    n = spec.mesh.level()["n_layers"]
+    h = gap(x, y)
+    k = mesh.layer
+    on_track = np.abs(y) < spec.supply.track_half_width
+    alpha = oil_fraction(spec, y, h * k / n, h * (k + 1) / n, h, on_track)
+    puddle = np.hypot(x, y) < spec.supply.initial_puddle * spec.a
+    return np.where(puddle, 1.0, alpha)
+
+
+def patch_faces(mesh: PolyMesh, name: str) -> slice:
+    for p in mesh.patches:
+        if p.name == name:
+            return slice(p.start, p.start + p.size)
+    raise KeyError(f"mesh has no patch {name!r}")
+
+
+def inlet_alpha(spec: CaseSpec, mesh: PolyMesh) -> np.ndarray:
+    """inletValue of alpha.oil on the inlet faces: the supply, on the track only."""
+    if spec.scene == "single-phase":
+        return np.ones(patch_faces(mesh, "inlet").stop - patch_faces(mesh, "inlet").start)
+    faces = mesh.faces[patch_faces(mesh, "inlet")]
+    z = mesh.points[faces, 2]
+    y = mesh.points[faces, 1].mean(axis=1)
+    z_lo, z_hi = z.min(axis=1), z.max(axis=1)
+    # the column height at the face: the highest point of the face's column
+    gap_h = np.full_like(z_hi, np.nan)
+    for key in np.unique(np.round(y, 12)):
+        sel = np.round(y, 12) == key
+        gap_h[sel] = z_hi[sel].max()
+    on_track = np.abs(y) < spec.supply.track_half_width
+    return oil_fraction(spec, y, z_lo, z_hi, gap_h, on_track)
+
+
+def island_velocity(spec: CaseSpec, mesh: PolyMesh) -> np.ndarray:
+    """Velocity of the island faces: (u, 0, 0) projected on the wall (no through-flow)."""
+    sl = patch_faces(mesh, "island")
+    n = mesh.face_areas[sl] / np.linalg.norm(mesh.face_areas[sl], axis=1, keepdims=True)
+    u = np.array([spec.speed if spec.walls_moving else 0.0, 0.0, 0.0])
+    return u - n * (n @ u)[:, None]
+
+
+# ----------------------------------------------------------------- writing
+def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, gap, geom: CaseGeometry) -> None:
+    u = spec.speed if spec.walls_moving else 0.0
+    with FoamFieldFile(case / "0.orig" / "U") as f:
+        f.boundary_field["disc"]["value"] = np.array([u, 0.0, 0.0])
+        f.boundary_field["ball"]["origin"] = np.array([0.0, 0.0, spec.contact.radius])
+        f.boundary_field["ball"]["omega"] = -u / spec.contact.radius
+        f.boundary_field["island"]["value"] = island_velocity(spec, mesh)
+        if not geom.symmetric:
+            del f.boundary_field["symmetry"]
+    with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
+        f.internal_field = initial_alpha(spec, mesh, gap)
+        f.boundary_field['"(disc|ball|island)"']["theta0"] = spec.physics.contact_angle
+        f.boundary_field["inlet"]["inletValue"] = inlet_alpha(spec, mesh)
+        if spec.scene == "single-phase":
+            f.boundary_field['"(outlet|side)"']["inletValue"] = 1.0
+        if not geom.symmetric:
+            del f.boundary_field["symmetry"]
+    if not geom.symmetric:
+        with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
+            del f.boundary_field["symmetry"]
+
+
+def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
+    p = spec.physics
+    with FoamFile(case / "constant" / "transportProperties") as f:
+        f["oil"]["nu"] = spec.oil_viscosity / spec.oil_density
+        f["oil"]["rho"] = spec.oil_density
+        f["air"]["nu"] = p.air_viscosity / p.air_density
+        f["air"]["rho"] = p.air_density
+        f["sigma"] = p.surface_tension
+    with FoamFile(case / "system" / "controlDict") as f:
+        f["endTime"] = geom.end_time
+        f["writeInterval"] = geom.write_interval
+        f["maxCo"] = spec.run.max_courant
+        f["maxAlphaCo"] = spec.run.max_alpha_courant
+        f["maxDeltaT"] = geom.max_delta_t
+    with FoamFile(case / "system" / "decomposeParDict") as f:
+        f["numberOfSubdomains"] = spec.run.n_procs
+
+
+def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int) -> None:
+    """Fill the runtime into the hand-runnable Allrun (launch words, application folder)."""
+    argv = runtime.command("APP")
+    app_path = Path(argv[-1])
+    values = {"@FOAM_LAUNCH@": shlex.join(argv[:-1]),
+              "@FOAM_BIN@": str(app_path.parent) if app_path.is_absolute() else "",
+              "@WM_PROJECT_DIR@": runtime.env({}).get("WM_PROJECT_DIR", ""),
+              "@NPROCS@": str(n_procs)}
+    text = (case / "Allrun").read_text()
+    for key, value in values.items():
+        text = text.replace(key, value)
+    (case / "Allrun").write_text(text)
+
+
+def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | None = None,
+               overwrite: bool = False) -> CaseGeometry:
+    """Build the case of ``spec`` in ``out`` (atomically: built in a temporary sibling folder
+    and renamed into place). Returns the case's :class:`CaseGeometry`."""
+    out = Path(out)
+    if out.exists() and any(out.iterdir()):
+        if not overwrite:
+            raise CaseExists(f"output folder {out} exists and is not empty (use --overwrite)")
+    runtime = runtime or FoamRuntime.from_environment()
+    gap, precalc = load_gap(spec.contact)
+    level, a = spec.mesh.level(), spec.a
+    d = spec.domain
+    params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
+                        island_radius=d.island_radius * a, n_layers=level["n_layers"],
+                        symmetric=d.symmetry == "half")
+    mesh = extrude(build_base_mesh(params, size_function(spec)), gap, level["n_layers"])
+    dx = level["size_rim"] * a
+    dt = capillary_time_step(spec, dx)
+    summary = _read_json(precalc / "summary.json")
+    hc = float(summary["hc_m"])
+    geom = CaseGeometry(
+        a=a, radius=spec.contact.radius, speed=spec.speed, x_min=params.x_min,
+        x_max=params.x_max, y_max=params.y_max, island_radius=params.island_radius,
+        symmetric=params.symmetric, n_layers=params.n_layers, cells=len(mesh.cell_volumes),
+        transit_time=spec.transit_time, end_time=spec.end_time,
+        write_interval=spec.transit_time / spec.run.writes_per_transit,
+        max_delta_t=min(dt, spec.transit_time / spec.run.writes_per_transit),
+        capillary_limit=spec.run.capillary_limit, min_cell_size=dx,
+        island_gap=float(gap(np.array([params.island_radius]), np.array([0.0]))[0]),
+        hc=hc, contact_flow=spec.speed * hc * 2.0 * a,
+        gap_mismatch=gap_mismatch(mesh, gap),
+        oil_viscosity=spec.oil_viscosity, oil_density=spec.oil_density)
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))
+    try:
+        shutil.copytree(TEMPLATES / _template_for(spec), tmp, dirs_exist_ok=True)
+        write_polymesh(mesh, tmp)
+        _edit_fields(spec, tmp, mesh, gap, geom)
+        _edit_dicts(spec, tmp, geom)
+        _write_scripts(tmp, runtime, spec.run.n_procs)
+        meta = tmp / META
+        meta.mkdir()
+        atomic_write_text(meta / "spec.json", spec.model_dump_json(indent=2) + "\n")
+        atomic_write_json(meta / "geometry.json", asdict(geom))
+        _save_structure(meta / "mesh.npz", mesh)
+        shutil.copytree(precalc, tmp / "precalc")
+        if out.exists():
+            shutil.rmtree(out)
+        os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return geom
+
+
+def _template_for(spec: CaseSpec) -> str:
+    return {"interface": "interface", "single-phase": "interface"}[spec.scene]
+
+
+def _read_json(path: Path) -> dict:
+    import json
+
+    return json.loads(path.read_text())
+
+
+def _save_structure(path: Path, mesh: PolyMesh) -> None:
+    """What the monitor needs to read fields without parsing the polyMesh: per cell its
+    centre, volume, 2D base cell and layer; the boundary patches' face ranges."""
+    names = np.array([p.name for p in mesh.patches])
+    starts = np.array([p.start for p in mesh.patches])
+    sizes = np.array([p.size for p in mesh.patches])
+    n_internal = len(mesh.neighbour)
+    with open(path, "wb") as fh:
+        np.savez_compressed(fh, cell_centres=mesh.cell_centres, cell_volumes=mesh.cell_volumes,
+                            base_cell=mesh.base_cell, layer=mesh.layer, patch_names=names,
+                            patch_starts=starts - n_internal, patch_sizes=sizes,
+                            face_centres_boundary=mesh.face_centres[n_internal:])
+
+
+def load_geometry(case: str | os.PathLike) -> CaseGeometry:
+    """The :class:`CaseGeometry` a generated case was written with."""
+    return CaseGeometry(**_read_json(Path(case) / META / "geometry.json"))
+
+
+def load_spec_of(case: str | os.PathLike) -> CaseSpec:
+    """The spec a generated case was written from."""
+    return CaseSpec.model_validate_json((Path(case) / META / "spec.json").read_text())

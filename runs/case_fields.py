@@ -1,0 +1,147 @@
+"""Read what a running or finished case wrote: time folders, fields, samples of the flow.
+
+The monitor calls :func:`sample` on every new time folder: the oil volume, the oil fluxes
+through the open boundaries and the flow-pattern metrics of the mid-gap oil fraction.
+Volumes and fluxes are for the whole contact (doubled in a half domain).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from foamlib import FoamFieldFile
+
+from generator.case_writer import META, CaseGeometry
+
+from . import metrics
+
+OPEN_PATCHES = ("inlet", "outlet", "side")
+
+
+@dataclass
+class Structure:
+    """The mesh structure the generator stored in ``ehlfoam/mesh.npz``."""
+
+    cell_volumes: np.ndarray
+    base_cell: np.ndarray
+    layer: np.ndarray
+    base_x: np.ndarray
+    base_y: np.ndarray
+    patches: dict[str, tuple[int, int]]  # name -> (start among boundary faces, size)
+
+    @classmethod
+    def load(cls, case: str | os.PathLike) -> "Structure":
+        d = np.load(Path(case) / META / "mesh.npz")
+        base = d["base_cell"]
+        n_base = int(base.max()) + 1
+        centres = d["cell_centres"]
+        count = np.bincount(base, minlength=n_base)
+        bx = np.bincount(base, centres[:, 0], minlength=n_base) / count
+        by = np.bincount(base, centres[:, 1], minlength=n_base) / count
+        patches = {str(n): (int(s), int(z)) for n, s, z in
+                   zip(d["patch_names"], d["patch_starts"], d["patch_sizes"])}
+        return cls(d["cell_volumes"], base, d["layer"], bx, by, patches)
+
+    def mid_gap(self, field: np.ndarray, n_layers: int) -> np.ndarray:
+        """Per base cell, the value at mid-gap (the middle layer, or the mean of the two
+        middle layers for an even count)."""
+        mid = [n_layers // 2] if n_layers % 2 else [n_layers // 2 - 1, n_layers // 2]
+        sel = np.isin(self.layer, mid)
+        n_base = len(self.base_x)
+        s = np.bincount(self.base_cell[sel], field[sel], minlength=n_base)
+        c = np.bincount(self.base_cell[sel], minlength=n_base)
+        return s / np.maximum(c, 1)
+
+
+def time_folders(case: str | os.PathLike) -> list[tuple[float, Path]]:
+    """Numeric time folders of the case (excluding 0), in time order."""
+    out = []
+    for p in Path(case).iterdir():
+        if not p.is_dir():
+            continue
+        try:
+            t = float(p.name)
+        except ValueError:
+            continue
+        if t > 0.0 and math.isfinite(t):
+            out.append((t, p))
+    return sorted(out)
+
+
+def _uniform_or_list(value, n: int) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        return np.full(n, float(arr))
+    return arr
+
+
+@dataclass
+class Sample:
+    """The state of the flow at one written time (SI; lengths in metrics as ratios to a)."""
+
+    time: float
+    oil_volume: float       # m3, whole contact
+    oil_in: float           # m3/s of oil entering through the open boundaries
+    oil_out: float          # m3/s of oil leaving
+    pattern: dict
+
+    def row(self) -> dict:
+        keys = ("state", "inlet_meniscus_distance_over_a", "flooded_length_over_a",
+                "flooded_width_over_a", "wake_gas_length_over_a", "enclosed_bubbles")
+        return {"time_s": self.time, "oil_volume_m3": self.oil_volume,
+                "oil_in_m3_s": self.oil_in, "oil_out_m3_s": self.oil_out,
+                **{k: self.pattern.get(k) for k in keys}}
+
+
+def pattern_geometry(geom: CaseGeometry) -> metrics.Geometry:
+    return metrics.Geometry(a=geom.a, island_radius=geom.island_radius, x_min=geom.x_min,
+                            x_max=geom.x_max, y_max=geom.y_max, symmetric=geom.symmetric)
+
+
+def mid_gap_alpha(folder: Path, structure: Structure, geom: CaseGeometry) -> np.ndarray:
+    alpha = _uniform_or_list(FoamFieldFile(folder / "alpha.oil").internal_field,
+                             len(structure.cell_volumes))
+    return structure.mid_gap(alpha, geom.n_layers)
+
+
+def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
+    """Read one time folder. Raises (OSError, ValueError, KeyError...) while the folder is
+    still being written; the caller retries."""
+    n = len(structure.cell_volumes)
+    alpha_file = FoamFieldFile(folder / "alpha.oil")
+    alpha = _uniform_or_list(alpha_file.internal_field, n)
+    if alpha.shape != (n,):
+        raise ValueError(f"{folder}/alpha.oil has {alpha.shape} values, expected {n}")
+    mirror = 2.0 if geom.symmetric else 1.0
+    volume = mirror * float(np.sum(np.clip(alpha, 0.0, 1.0) * structure.cell_volumes))
+    # the oil flux MULES transported (alphaPhi0.oil); phi * face alpha where it is absent
+    oil_flux_file = folder / "alphaPhi0.oil"
+    flux_bf = FoamFieldFile(oil_flux_file if oil_flux_file.exists() else folder / "phi").boundary_field
+    alpha_bf = alpha_file.boundary_field
+    q_in = q_out = 0.0
+    for name in OPEN_PATCHES:
+        if name not in structure.patches:
+            continue
+        size = structure.patches[name][1]
+        flux = _uniform_or_list(flux_bf[name]["value"], size)   # outward, per face
+        if not oil_flux_file.exists():
+            flux = flux * np.clip(_uniform_or_list(alpha_bf[name]["value"], size), 0.0, 1.0)
+        q_in += mirror * float(-flux[flux < 0].sum())
+        q_out += mirror * float(flux[flux > 0].sum())
+    mid = structure.mid_gap(alpha, geom.n_layers)
+    pattern = metrics.flow_pattern(structure.base_x, structure.base_y, mid,
+                                   pattern_geometry(geom))
+    return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
+                  pattern=pattern)
+
+
+def initial_oil_volume(case: Path, structure: Structure, geom: CaseGeometry) -> float:
+    """Oil volume at t = 0 [m3, whole contact] from 0.orig."""
+    alpha = _uniform_or_list(FoamFieldFile(case / "0.orig" / "alpha.oil").internal_field,
+                             len(structure.cell_volumes))
+    mirror = 2.0 if geom.symmetric else 1.0
+    return mirror * float(np.sum(np.clip(alpha, 0.0, 1.0) * structure.cell_volumes))

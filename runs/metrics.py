@@ -1,0 +1,487 @@
+"""Flow-pattern metrics from the oil volume fraction on the mid-gap surface.
+
+The input is the oil volume fraction ``alpha`` (0 = air, 1 = oil) at the 2D
+cell centres ``(x, y)`` [m] of the thin-gap mesh's base mesh, plus the
+:class:`Geometry` of the domain: ``x`` is the rolling direction (oil comes
+from ``x < 0`` toward the contact at the origin), the Hertzian contact has
+radius ``a`` and the mesh has a circular hole (the "island" wall) of radius
+``island_radius >= a`` at the origin. The island is the contact: neither oil
+nor gas. The domain is the rectangle ``x_min <= x <= x_max`` and
+``0 <= y <= y_max`` (``symmetric``, a half domain mirrored to the full picture
+``y -> -y``) or ``-y_max <= y <= y_max``; its edges are open to the outer air.
+
+Two steps:
+
+:func:`raster`
+    resamples the field onto a regular grid of the full domain (linear
+    interpolation on the Delaunay triangulation of the cell centres, nearest
+    centre outside their convex hull), island pixels flagged.
+:func:`flow_pattern` (or :func:`flow_pattern_from_raster`)
+    classifies the topology of oil (``alpha >= threshold``) and gas and
+    measures the meniscus. Gas regions are labelled with 4-connectivity,
+    oil regions with 8-connectivity (the usual complementary pair, so that a
+    gas region that is not connected to the edge is truly enclosed by oil).
+    "Outer air" is gas connected to the domain edge, the "flooded region"
+    the oil connected to the island rim (the pixels next to the island).
+    State I: no outer air touches the island rim (the flooded region closes
+    around the contact; gas at the rim, if any, is an enclosed bubble).
+    State II: outer air reaches the rim (an open wake, or a starved inlet).
+
+Inside, everything is SI; the lengths returned are ratios to ``a``.
+:func:`meniscus_contours` gives the ``alpha = threshold`` lines for plots.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator
+from scipy.spatial import QhullError
+
+__all__ = [
+    "Geometry",
+    "Raster",
+    "flow_pattern",
+    "flow_pattern_from_raster",
+    "meniscus_contours",
+    "raster",
+]
+
+#: Default raster spacing as a fraction of the contact radius ``a``.
+DEFAULT_CELL_OVER_A = 1.0 / 20.0
+#: Largest raster accepted (pixels), to refuse a ``cell`` far too small.
+MAX_PIXELS = 20_000_000
+#: alpha values further than this outside [0, 1] are refused (not a fraction).
+ALPHA_TOLERANCE = 0.5
+#: Relative slack on the domain rectangle when checking the cell centres.
+DOMAIN_SLACK = 0.01
+
+_FOUR = ndimage.generate_binary_structure(2, 1)
+_EIGHT = ndimage.generate_binary_structure(2, 2)
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """The domain around the contact, all lengths in metres.
+
+    ``a``: Hertzian contact radius; ``island_radius``: radius of the mesh's
+    hole at the origin (``>= a``); ``x_min < -island_radius`` and
+    ``x_max > island_radius``: inlet and outlet ends; ``y_max >
+    island_radius``: the side edge(s); ``symmetric``: the mesh covers
+    ``y >= 0`` only (mirrored for the analysis), else ``|y| <= y_max``.
+    """
+
+    a: float
+    island_radius: float
+    x_min: float
+    x_max: float
+    y_max: float
+    symmetric: bool = True
+
+    def __post_init__(self) -> None:
+        for name in ("a", "island_radius", "x_min", "x_max", "y_max"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
+                raise ValueError(f"{name}: must be a finite number, got {value!r}")
+        if self.a <= 0:
+            raise ValueError(f"a: must be > 0, got {self.a!r}")
+        if self.island_radius < self.a:
+            raise ValueError(f"island_radius: must be >= a ({self.a!r}), got {self.island_radius!r}")
+        if self.x_min >= -self.island_radius:
+            raise ValueError(f"x_min: must be < -island_radius, got {self.x_min!r}")
+        if self.x_max <= self.island_radius:
+            raise ValueError(f"x_max: must be > island_radius, got {self.x_max!r}")
+        if self.y_max <= self.island_radius:
+            raise ValueError(f"y_max: must be > island_radius, got {self.y_max!r}")
+
+    @property
+    def y_min(self) -> float:
+        """Lower y edge of the mesh: 0 for a half domain, else ``-y_max``."""
+        return 0.0 if self.symmetric else -self.y_max
+
+
+@dataclass(frozen=True, eq=False)
+class Raster:
+    """The field on a regular grid of the full (mirrored) domain.
+
+    ``x`` (nx,) and ``y`` (ny,) are the pixel centres [m], ascending; the grid
+    includes the domain edges and the row ``y = 0``. ``alpha`` (ny, nx) is
+    clipped to [0, 1] and NaN on the island; ``island`` (ny, nx) flags the
+    pixels with ``x^2 + y^2 <= island_radius^2``.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    alpha: np.ndarray
+    island: np.ndarray
+    geom: Geometry
+
+    @property
+    def dx(self) -> float:
+        """Pixel spacing along x [m]."""
+        return float(self.x[1] - self.x[0])
+
+    @property
+    def dy(self) -> float:
+        """Pixel spacing along y [m]."""
+        return float(self.y[1] - self.y[0])
+
+    @property
+    def axis_row(self) -> int:
+        """Index of the row ``y = 0``."""
+        return int(np.argmin(np.abs(self.y)))
+
+    def oil(self, threshold: float = 0.5) -> np.ndarray:
+        """Oil pixels: ``alpha >= threshold`` outside the island."""
+        return ~self.island & (np.nan_to_num(self.alpha, nan=0.0) >= threshold)
+
+    def gas(self, threshold: float = 0.5) -> np.ndarray:
+        """Gas pixels: ``alpha < threshold`` outside the island."""
+        return ~self.island & (np.nan_to_num(self.alpha, nan=1.0) < threshold)
+
+
+# --------------------------------------------------------------------------
+# input checks
+
+
+def _as_1d(name: str, values: Any) -> np.ndarray:
+    arr = np.asarray(values, dtype=float)
+    if arr.ndim != 1:
+        raise ValueError(f"{name}: must be one-dimensional, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name}: contains non-finite values")
+    return arr
+
+
+def _check_threshold(threshold: float) -> float:
+    if not isinstance(threshold, (int, float, np.integer, np.floating)) or not 0.0 < threshold < 1.0:
+        raise ValueError(f"threshold: must be in (0, 1), got {threshold!r}")
+    return float(threshold)
+
+
+def _check_inputs(x: Any, y: Any, alpha: Any, geom: Geometry) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Validate the cell-centre data; returns float arrays, alpha clipped to [0, 1]."""
+    if not isinstance(geom, Geometry):
+        raise ValueError(f"geom: must be a Geometry, got {type(geom).__name__}")
+    x, y, alpha = _as_1d("x", x), _as_1d("y", y), _as_1d("alpha", alpha)
+    if len(y) != len(x):
+        raise ValueError(f"y: length {len(y)} differs from x's {len(x)}")
+    if len(alpha) != len(x):
+        raise ValueError(f"alpha: length {len(alpha)} differs from x's {len(x)}")
+    if len(x) < 3:
+        raise ValueError(f"x: at least 3 cell centres needed, got {len(x)}")
+    if alpha.min() < -ALPHA_TOLERANCE or alpha.max() > 1.0 + ALPHA_TOLERANCE:
+        raise ValueError(
+            f"alpha: values in [{alpha.min():g}, {alpha.max():g}] are not a volume fraction")
+    slack_x = DOMAIN_SLACK * (geom.x_max - geom.x_min)
+    slack_y = DOMAIN_SLACK * geom.y_max
+    if x.min() < geom.x_min - slack_x or x.max() > geom.x_max + slack_x:
+        raise ValueError(
+            f"x: centres span [{x.min():g}, {x.max():g}] m, outside the domain "
+            f"[{geom.x_min:g}, {geom.x_max:g}] m (units?)")
+    if y.min() < geom.y_min - slack_y or y.max() > geom.y_max + slack_y:
+        raise ValueError(
+            f"y: centres span [{y.min():g}, {y.max():g}] m, outside the domain "
+            f"[{geom.y_min:g}, {geom.y_max:g}] m (symmetric={geom.symmetric}; units?)")
+    return x, y, np.clip(alpha, 0.0, 1.0)
+
+
+# --------------------------------------------------------------------------
+# resampling
+
+
+def _grid(geom: Geometry, cell: float) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel centres spanning the full domain, edges and ``y = 0`` included."""
+    nx = max(2, int(round((geom.x_max - geom.x_min) / cell)) + 1)
+    half = max(1, int(round(geom.y_max / cell)))
+    if nx * (2 * half + 1) > MAX_PIXELS:
+        raise ValueError(f"cell: {cell:g} m gives more than {MAX_PIXELS} pixels")
+    xs = np.linspace(geom.x_min, geom.x_max, nx)
+    ys = np.linspace(-geom.y_max, geom.y_max, 2 * half + 1)
+    ys[half] = 0.0
+    return xs, ys
+
+
+def raster(x: Any, y: Any, alpha: Any, geom: Geometry, cell: float | None = None) -> Raster:
+    """Resample ``alpha`` at cell centres ``(x, y)`` onto a regular full-domain grid.
+
+    ``cell`` is the pixel size [m] (default ``a/20``; the spacing is adjusted
+    so the grid ends on the domain edges). A half domain is mirrored
+    (``y -> -y``) before the interpolation. Linear interpolation on the
+    Delaunay triangulation of the centres; pixels outside their convex hull
+    (next to the domain edges) take the nearest centre's value. alpha is
+    clipped to [0, 1]; island pixels are NaN.
+
+    Raises ValueError (naming the parameter) on malformed input.
+    """
+    x, y, alpha = _check_inputs(x, y, alpha, geom)
+    if cell is None:
+        cell = DEFAULT_CELL_OVER_A * geom.a
+    if not isinstance(cell, (int, float, np.integer, np.floating)) or not math.isfinite(cell) or cell <= 0:
+        raise ValueError(f"cell: must be a positive finite length, got {cell!r}")
+    if geom.symmetric:
+        upper = y > 0.0
+        x, y, alpha = (np.concatenate([x, x[upper]]), np.concatenate([y, -y[upper]]),
+                       np.concatenate([alpha, alpha[upper]]))
+    xs, ys = _grid(geom, float(cell))
+    gx, gy = np.meshgrid(xs, ys)
+    points = np.column_stack([x, y])
+    try:
+        values = LinearNDInterpolator(points, alpha)(gx, gy)
+    except QhullError as exc:
+        raise ValueError(f"x, y: the cell centres cannot be triangulated ({exc})") from None
+    outside = np.isnan(values)
+    if outside.any():
+        values[outside] = NearestNDInterpolator(points, alpha)(gx[outside], gy[outside])
+    island = gx**2 + gy**2 <= geom.island_radius**2
+    values = np.clip(values, 0.0, 1.0)
+    values[island] = np.nan
+    return Raster(x=xs, y=ys, alpha=values, island=island, geom=geom)
+
+
+# --------------------------------------------------------------------------
+# topology
+
+
+def _edge_mask(shape: tuple[int, int]) -> np.ndarray:
+    edge = np.zeros(shape, dtype=bool)
+    edge[0, :] = edge[-1, :] = edge[:, 0] = edge[:, -1] = True
+    return edge
+
+
+def _rim_mask(island: np.ndarray) -> np.ndarray:
+    """Pixels outside the island that touch it (8-neighbourhood)."""
+    return ndimage.binary_dilation(island, structure=_EIGHT) & ~island
+
+
+def _outer_air(gas: np.ndarray) -> tuple[np.ndarray, int]:
+    """(gas connected to the domain edge, number of enclosed gas regions)."""
+    labels, count = ndimage.label(gas, structure=_FOUR)
+    edge_labels = np.unique(labels[_edge_mask(gas.shape) & gas])
+    outer = np.isin(labels, edge_labels) & gas
+    return outer, int(count - len(edge_labels))
+
+
+def _flooded(oil: np.ndarray, rim: np.ndarray) -> np.ndarray:
+    """Oil pixels connected (8-neighbourhood) to the island rim."""
+    labels, _ = ndimage.label(oil, structure=_EIGHT)
+    rim_labels = np.unique(labels[rim & oil])
+    return np.isin(labels, rim_labels[rim_labels > 0])
+
+
+# --------------------------------------------------------------------------
+# measurements
+
+
+def _crossing(x0: float, a0: float, x1: float, a1: float, threshold: float) -> float:
+    """Where the linear interpolant between (x0, a0) and (x1, a1) crosses threshold."""
+    if a1 == a0:
+        return float(0.5 * (x0 + x1))
+    return float(x0 + (x1 - x0) * (threshold - a0) / (a1 - a0))
+
+
+def _far_extent(region: np.ndarray, alpha: np.ndarray, gas: np.ndarray,
+                coords: np.ndarray, threshold: float) -> float:
+    """Largest coordinate of ``region`` along axis 1 (ascending ``coords``).
+
+    A region pixel whose next pixel is gas extends to the interpolated
+    ``alpha = threshold`` crossing between the two.
+    """
+    reach = np.broadcast_to(coords, region.shape).astype(float).copy()
+    step = np.diff(coords)
+    a0, a1 = alpha[:, :-1], alpha[:, 1:]
+    ends = region[:, :-1] & gas[:, 1:]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        frac = np.where(ends, (a0 - threshold) / (a0 - a1), 0.0)
+    reach[:, :-1] += np.clip(np.nan_to_num(frac), 0.0, 1.0) * step
+    return float(reach[region].max())
+
+
+def _extent(region: np.ndarray, alpha: np.ndarray, gas: np.ndarray,
+            coords: np.ndarray, threshold: float) -> tuple[float, float]:
+    """(min, max) coordinate of ``region`` along axis 1, sub-pixel."""
+    hi = _far_extent(region, alpha, gas, coords, threshold)
+    lo = -_far_extent(region[:, ::-1], alpha[:, ::-1], gas[:, ::-1], -coords[::-1], threshold)
+    return lo, hi
+
+
+def _upstream_meniscus(r: Raster, row: int, region: np.ndarray, threshold: float) -> tuple[float | None, bool]:
+    """Upstream meniscus x [m] on one raster row, and whether it is at the rim.
+
+    Walks upstream from the first pixel upstream of the island through the
+    ``region`` pixels to the first pixel outside it, and interpolates the
+    ``alpha = threshold`` crossing. If the starting pixel is not in
+    ``region`` the meniscus is at (or inside) the island rim: returns the rim
+    position ``-sqrt(R^2 - y^2)`` (0 beyond the island) and True. Returns
+    (None, False) when ``region`` reaches the inlet edge.
+    """
+    upstream = np.flatnonzero((r.x < 0.0) & ~r.island[row])
+    if upstream.size == 0:
+        return None, False
+    start = int(upstream[-1])
+    if not region[row, start]:
+        rim = -math.sqrt(max(r.geom.island_radius**2 - float(r.y[row]) ** 2, 0.0))
+        return rim, True
+    outside = np.flatnonzero(~region[row, : start + 1])
+    if outside.size == 0:
+        return None, False
+    k = int(outside[-1])
+    alpha = r.alpha[row]
+    return _crossing(r.x[k], alpha[k], r.x[k + 1], alpha[k + 1], threshold), False
+
+
+def _meniscus_shape(r: Raster, flooded: np.ndarray, threshold: float) -> tuple[str | None, float | None]:
+    """("convex" | "concave" | None, c2) from a fit x_m/a = c0 + c2 (y/a)^2 over |y| <= R."""
+    a = r.geom.a
+    ys, xm, any_free = [], [], False
+    for row in np.flatnonzero(np.abs(r.y) <= r.geom.island_radius):
+        pos, at_rim = _upstream_meniscus(r, int(row), flooded, threshold)
+        if pos is None:
+            continue
+        ys.append(float(r.y[row]) / a)
+        xm.append(pos / a)
+        any_free |= not at_rim
+    if not any_free or len(set(np.round(np.square(ys), 12))) < 2 or len(ys) < 3:
+        return None, None
+    design = np.column_stack([np.ones(len(ys)), np.square(ys)])
+    (_, c2), *_ = np.linalg.lstsq(design, np.asarray(xm), rcond=None)
+    # A bulge below a tenth of a pixel over the fitted span is a flat meniscus.
+    bulge = abs(c2) * max(np.square(ys)) * a
+    if bulge < 0.1 * r.dx:
+        return None, float(c2)
+    return ("convex" if c2 > 0 else "concave"), float(c2)
+
+
+def _wake_gas_end(r: Raster, gas: np.ndarray, oil: np.ndarray, threshold: float) -> float | None:
+    """x [m] where the gas run downstream of the island ends on y = 0, None if oil follows the rim."""
+    row = r.axis_row
+    downstream = np.flatnonzero((r.x > 0.0) & ~r.island[row])
+    start = int(downstream[0])
+    if not gas[row, start]:
+        return None
+    after = np.flatnonzero(oil[row, start:])
+    if after.size == 0:
+        return float(r.x[-1])
+    k = start + int(after[0])
+    alpha = r.alpha[row]
+    return _crossing(r.x[k - 1], alpha[k - 1], r.x[k], alpha[k], threshold)
+
+
+# --------------------------------------------------------------------------
+# public API
+
+
+def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any]:
+    """Flow-pattern metrics of a :class:`Raster`; see :func:`flow_pattern`."""
+    threshold = _check_threshold(threshold)
+    if not isinstance(r, Raster):
+        raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
+    a = r.geom.a
+    oil, gas = r.oil(threshold), r.gas(threshold)
+    rim = _rim_mask(r.island)
+    outer, enclosed = _outer_air(gas)
+    flooded = _flooded(oil, rim)
+    outer_rim = outer & rim
+    xx = np.broadcast_to(r.x, r.island.shape)
+    inlet_starved = bool((outer_rim & (xx < 0.0)).any())
+    wake_open = bool((outer_rim & (xx > 0.0)).any())
+    state = "II" if outer_rim.any() else "I"
+
+    inlet_x, inlet_at_rim = _upstream_meniscus(r, r.axis_row, oil, threshold)
+    inlet = None if inlet_x is None else max(0.0, float((-a - inlet_x) / a))
+    shape, c2 = _meniscus_shape(r, flooded, threshold)
+
+    length = width = x_lo = x_hi = None
+    if flooded.any():
+        alpha = np.nan_to_num(r.alpha, nan=0.0)
+        x_lo, x_hi = _extent(flooded, alpha, gas, r.x, threshold)
+        y_lo, y_hi = _extent(flooded.T, alpha.T, gas.T, r.y, threshold)
+        length, width = float((x_hi - x_lo) / a), float((y_hi - y_lo) / a)
+        x_lo, x_hi = x_lo / a, x_hi / a
+
+    wake_end = _wake_gas_end(r, gas, oil, threshold)
+    wake = 0.0 if wake_end is None else max(0.0, (wake_end - a) / a)
+    free = ~r.island
+    return {
+        "state": state,
+        "inlet_meniscus_distance_over_a": inlet,
+        "inlet_meniscus_at_rim": bool(inlet_at_rim),
+        "inlet_meniscus_shape": shape,
+        "inlet_meniscus_c2": c2,
+        "flooded_length_over_a": length,
+        "flooded_width_over_a": width,
+        "flooded_x_min_over_a": x_lo,
+        "flooded_x_max_over_a": x_hi,
+        "wake_gas_length_over_a": float(wake),
+        "wake_open": wake_open,
+        "inlet_starved": inlet_starved,
+        "enclosed_bubbles": enclosed,
+        "oil_area_fraction": float(oil.sum() / free.sum()),
+        "mean_alpha": float(np.nanmean(r.alpha[free])),
+    }
+
+
+def flow_pattern(x: Any, y: Any, alpha: Any, geom: Geometry, threshold: float = 0.5,
+                 cell: float | None = None) -> dict[str, Any]:
+    """Flow-pattern metrics from alpha at the mid-gap cell centres.
+
+    ``x``, ``y`` [m], ``alpha`` (clipped to [0, 1]) are equal-length 1D
+    arrays; ``cell`` is the raster size (default ``a/20``, see :func:`raster`).
+    Lengths are ratios to ``a``; undefined values are None (never NaN).
+
+    Keys:
+
+    ``state``
+        "I" (no outer air touches the island rim) or "II" (it does).
+    ``inlet_meniscus_distance_over_a``
+        on ``y = 0``, from ``x = -a`` upstream to the first oil->gas crossing
+        of ``alpha = threshold`` upstream of the island rim (>= 0). When gas
+        touches the rim on the inlet side the meniscus is at or inside the
+        rim: ``(island_radius - a)/a`` (and ``inlet_meniscus_at_rim``).
+        None when oil reaches the inlet edge ``x_min``.
+    ``inlet_meniscus_at_rim``
+        the axis meniscus is at (or hidden inside) the island rim.
+    ``inlet_meniscus_shape``, ``inlet_meniscus_c2``
+        fit ``x_m/a = c0 + c2 (y/a)^2`` of the upstream meniscus of the
+        flooded region over the rows ``|y| <= island_radius`` (rows where gas
+        touches the rim count at the rim): "convex" (``c2 > 0``, bulging
+        upstream) or "concave" (``c2 < 0``, the butterfly of a starved
+        inlet); None when undefined (no meniscus off the rim, oil to the
+        inlet, or flat within a tenth of a pixel).
+    ``flooded_length_over_a``, ``flooded_width_over_a``,
+    ``flooded_x_min_over_a``, ``flooded_x_max_over_a``
+        extents of the flooded region (oil connected to the island rim) in
+        the full picture, to the interpolated crossings; None without one.
+    ``wake_gas_length_over_a``
+        if gas follows the island rim downstream on ``y = 0``, from
+        ``x = a`` to the end of that gas run (next gas->oil crossing or
+        ``x_max``); 0.0 if oil follows the rim.
+    ``wake_open``, ``inlet_starved``
+        outer air touches the rim at ``x > 0`` / ``x < 0``.
+    ``enclosed_bubbles``
+        number of gas regions (4-connected) not connected to the edge.
+    ``oil_area_fraction``, ``mean_alpha``
+        area fraction with ``alpha >= threshold`` and mean alpha, island
+        excluded.
+    """
+    threshold = _check_threshold(threshold)
+    return flow_pattern_from_raster(raster(x, y, alpha, geom, cell), threshold)
+
+
+def meniscus_contours(r: Raster, threshold: float = 0.5) -> list[np.ndarray]:
+    """The ``alpha = threshold`` lines of a raster as (k, 2) arrays of (x, y) [m].
+
+    The island is masked out: lines stop at it rather than cross it.
+    """
+    import contourpy
+
+    threshold = _check_threshold(threshold)
+    if not isinstance(r, Raster):
+        raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
+    z = np.ma.masked_array(np.nan_to_num(r.alpha, nan=0.0), mask=r.island)
+    gen = contourpy.contour_generator(x=r.x, y=r.y, z=z, line_type=contourpy.LineType.Separate)
+    return [np.asarray(line, dtype=float) for line in gen.lines(threshold) if len(line) >= 2]

@@ -1,0 +1,282 @@
+"""Run a generated case to steady state and write ``DIR/metrics.json``.
+
+interFoam runs as a child process (through :mod:`runs.foam_runtime`). Function objects fail in
+Debian 13's OpenFOAM build, so the monitor watches from outside: it reads every time folder
+the solver writes (oil volume, oil fluxes through the open boundaries, the flow pattern on the
+mid-gap surface), keeps ``DIR/history.csv``, and stops the solver through controlDict
+(``stopAt writeNow``) when the oil volume and the meniscus positions have changed by less than
+the tolerance over one transit time. End reasons:
+
+- ``steady``: the steady-state test passed;
+- ``end_time``: the simulated time limit was reached first;
+- ``wall_limit``: the wall-clock limit was reached first;
+- ``diverged``: the solver failed (non-zero exit, e.g. a floating-point trap) or its time
+  step collapsed; the logs stay and metrics.json says ``status: failed``;
+- ``interrupted``: Ctrl-C or SIGTERM; the solver is stopped with a final write.
+"""
+
+from __future__ import annotations
+
+import csv
+import fcntl
+import io
+import math
+import re
+import shutil
+import signal
+import subprocess
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+from foamlib import FoamFile
+
+from ehl_precalc.outputs import atomic_write_json, atomic_write_text
+from generator.case_writer import META, CaseGeometry, load_geometry, load_spec_of
+
+from . import case_fields
+from .foam_runtime import FoamRuntime
+
+LOG = "log.interFoam"
+POLL_S = 1.0
+STOP_GRACE_S = 120.0
+DT_COLLAPSE = 1e-4          # time step below this fraction of maxDeltaT counts as collapse
+DT_COLLAPSE_STEPS = 200     # ... for this many consecutive logged steps
+
+
+class CaseBusy(RuntimeError):
+    """Another process is running this case."""
+
+
+def _steady(history: list[case_fields.Sample], window: float, tol: float,
+            length_scale: float) -> bool:
+    """Oil volume within ``tol`` (relative) and meniscus positions within
+    ``tol * length_scale`` (units a) of their values one ``window`` ago."""
+    if not history or history[-1].time - history[0].time < window * (1 - 1e-9):
+        return False
+    now = history[-1]
+    then = min(history, key=lambda s: abs(s.time - (now.time - window)))
+    if now.time - then.time < 0.5 * window:
+        return False
+    if abs(now.oil_volume - then.oil_volume) > tol * max(now.oil_volume, 1e-300):
+        return False
+    if now.pattern.get("state") != then.pattern.get("state"):
+        return False
+    for key in ("inlet_meniscus_distance_over_a", "flooded_length_over_a",
+                "flooded_width_over_a", "wake_gas_length_over_a"):
+        a, b = now.pattern.get(key), then.pattern.get(key)
+        if (a is None) != (b is None):
+            return False
+        if a is not None and abs(a - b) > tol * length_scale:
+            return False
+    return True
+
+
+def _set_stop(case: Path, value: str) -> None:
+    with FoamFile(case / "system" / "controlDict") as f:
+        f["stopAt"] = value
+
+
+_STEP = re.compile(r"^deltaT = ([-+0-9.eE]+)\s*$", re.M)
+_TIME = re.compile(r"^Time = ([-+0-9.eE]+)\s*$", re.M)
+
+
+class LogTail:
+    """Incremental reader of the solver log: time steps and the last deltaT values."""
+
+    def __init__(self, path: Path):
+        self.path, self.offset, self.steps, self.small_steps = path, 0, 0, 0
+        self.last_dt = math.nan
+        self.last_time = 0.0
+
+    def update(self, dt_floor: float) -> None:
+        try:
+            with open(self.path, "rb") as fh:
+                fh.seek(self.offset)
+                chunk = fh.read()
+        except FileNotFoundError:
+            return
+        cut = chunk.rfind(b"\n") + 1
+        self.offset += cut
+        text = chunk[:cut].decode("utf-8", "replace")
+        for m in _STEP.finditer(text):
+            self.last_dt = float(m.group(1))
+            self.small_steps = self.small_steps + 1 if self.last_dt < dt_floor else 0
+        times = _TIME.findall(text)
+        self.steps += len(times)
+        if times:
+            self.last_time = float(times[-1])
+
+
+def _write_history(case: Path, history: list[case_fields.Sample]) -> None:
+    if not history:
+        return
+    buf = io.StringIO()
+    rows = [s.row() for s in history]
+    writer = csv.DictWriter(buf, fieldnames=list(rows[0]))
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write_text(case / "history.csv", buf.getvalue())
+
+
+def _mass_balance(v0: float, history: list[case_fields.Sample]) -> dict:
+    """Oil volume change against the time integral of the oil fluxes through the open
+    boundaries, from the first to the last written time (trapezoid over the writes; before
+    the first write the fluxes are not known). The error is relative to the oil carried in
+    over that window (or to the oil volume when almost nothing came in)."""
+    if len(history) < 2:
+        return {"oil_carried_in_m3": None, "oil_carried_out_m3": None,
+                "oil_mass_balance_error": None}
+    t = np.array([s.time for s in history])
+    carried_in = float(np.trapezoid([s.oil_in for s in history], t))
+    carried_out = float(np.trapezoid([s.oil_out for s in history], t))
+    residual = history[-1].oil_volume - history[0].oil_volume - (carried_in - carried_out)
+    by_inflow = carried_in > 0.01 * history[-1].oil_volume
+    scale = carried_in if by_inflow else history[-1].oil_volume
+    return {"oil_carried_in_m3": carried_in, "oil_carried_out_m3": carried_out,
+            "oil_mass_balance_residual_m3": residual,
+            "oil_mass_balance_error": abs(residual) / scale if scale > 0 else None,
+            "oil_mass_balance_reference": "oil carried in" if by_inflow else "oil volume",
+            "oil_mass_balance_window_s": [float(t[0]), float(t[-1])]}
+
+
+def run_case(case: str | Path, runtime: FoamRuntime | None = None,
+             wall_limit: float | None = None,
+             on_sample: Callable[[case_fields.Sample, CaseGeometry], None] | None = None) -> dict:
+    """Run the case in ``case`` to steady state (or a limit) and write ``metrics.json``.
+
+    Restarts from the latest written time if the case ran before. Returns the metrics dict.
+    """
+    case = Path(case).absolute()
+    spec, geom = load_spec_of(case), load_geometry(case)
+    structure = case_fields.Structure.load(case)
+    runtime = runtime or FoamRuntime.from_environment()
+    wall_limit = wall_limit or spec.run.wall_limit
+    lock = open(case / META / "run.lock", "w")
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise CaseBusy(f"case {case} is being run by another process") from None
+    try:
+        return _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample)
+    finally:
+        lock.close()
+
+
+def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> dict:
+    atomic_write_json(case / "metrics.json", {"status": "running", "cells": geom.cells})
+    if not (case / "0").is_dir():
+        shutil.copytree(case / "0.orig", case / "0")
+    _set_stop(case, "endTime")
+    v0 = case_fields.initial_oil_volume(case, structure, geom)
+    history: list[case_fields.Sample] = []
+    done: set[str] = set()
+    for _, folder in case_fields.time_folders(case):   # a restart: earlier writes count
+        history.append(case_fields.sample(folder, structure, geom))
+        done.add(folder.name)
+    log_path = case / LOG
+    if log_path.exists():
+        log_path.rename(case / f"{LOG}.{int(time.time())}")
+    tail = LogTail(log_path)
+    dt_floor = DT_COLLAPSE * geom.max_delta_t
+    t_start = time.monotonic()
+    proc = runtime.popen("interFoam", [], cwd=case, log_path=LOG)
+    reason, stopping_since = None, None
+    previous = signal.getsignal(signal.SIGTERM)
+    signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        while True:
+            exited = proc.poll() is not None
+            tail.update(dt_floor)
+            for _, folder in case_fields.time_folders(case):
+                if folder.name in done:
+                    continue
+                try:
+                    s = case_fields.sample(folder, structure, geom)
+                except Exception:
+                    if exited:
+                        done.add(folder.name)
+                    continue   # still being written: next poll
+                done.add(folder.name)
+                history.append(s)
+                _write_history(case, history)
+                if on_sample:
+                    on_sample(s, geom)
+            if exited:
+                break
+            if reason is None:
+                if _steady(history, geom.transit_time, spec.run.steady_tolerance,
+                           spec.run.transit_length):
+                    reason = "steady"
+                elif time.monotonic() - t_start > wall_limit:
+                    reason = "wall_limit"
+                elif tail.small_steps >= DT_COLLAPSE_STEPS:
+                    reason = "diverged"
+                    proc.kill()
+                if reason in ("steady", "wall_limit"):
+                    _set_stop(case, "writeNow")
+                    stopping_since = time.monotonic()
+            elif stopping_since and time.monotonic() - stopping_since > STOP_GRACE_S:
+                proc.kill()
+            time.sleep(POLL_S)
+    except KeyboardInterrupt:
+        reason = "interrupted"
+        _set_stop(case, "writeNow")
+        try:
+            proc.wait(timeout=STOP_GRACE_S)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        if proc.poll() is None:
+            proc.kill()
+        proc.wait()
+    wall = time.monotonic() - t_start
+    rc = proc.returncode
+    if reason is None:
+        reason = "end_time" if rc == 0 else "diverged"
+    failed = reason == "diverged" or (rc != 0 and reason not in ("interrupted",) and rc != -9)
+    metrics = _final_metrics(spec, geom, v0, history, reason, failed, rc, tail, wall, case)
+    atomic_write_json(case / "metrics.json", metrics)
+    return metrics
+
+
+def _raise_interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, tail, wall, case) -> dict:
+    last = history[-1] if history else None
+    pattern = dict(last.pattern) if last else {}
+    out = {
+        "status": "failed" if failed else ("interrupted" if reason == "interrupted" else "finished"),
+        "end_reason": reason,
+        "steady": reason == "steady",
+        "solver_exit_code": rc,
+        "simulated_time_s": last.time if last else 0.0,
+        "transit_time_s": geom.transit_time,
+        **pattern,
+        "oil_volume_m3": last.oil_volume if last else v0,
+        "oil_volume_initial_m3": v0,
+        "oil_inflow_m3_s": last.oil_in if last else None,
+        "oil_outflow_m3_s": last.oil_out if last else None,
+        **_mass_balance(v0, history),
+        "contact_flow_m3_s": geom.contact_flow,
+        "contact_flow_over_inflow": (geom.contact_flow / last.oil_in
+                                     if last and last.oil_in > 0 else None),
+        "cells": geom.cells,
+        "time_steps": tail.steps,
+        "last_delta_t_s": tail.last_dt,
+        "max_delta_t_s": geom.max_delta_t,
+        "wall_s": wall,
+        "wall_s_per_simulated_ms": wall / (1e3 * last.time) if last and last.time > 0 else None,
+        "a_m": geom.a,
+        "speed_m_s": geom.speed,
+        "mesh_gap_mismatch": geom.gap_mismatch,
+    }
+    if failed:
+        log = case / LOG
+        lines = log.read_text(errors="replace").splitlines()[-20:] if log.exists() else []
+        out["log_tail"] = lines
+    return out

@@ -1,0 +1,422 @@
+"""Tests of generator.mesh: gmsh base mesh, extrusion, polyMesh writer.
+
+Real gmsh and real OpenFOAM (checkMesh through runs.foam_runtime), no
+mocks. Geometry: the reference contact (ball radius 9.525 mm, Hertz radius
+0.1371 mm) with a dry-Hertz-like gap.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import gmsh
+import numpy as np
+import pytest
+
+from generator.mesh import (
+    PATCH_TYPES,
+    BaseMesh,
+    MeshParams,
+    PolyMesh,
+    build_base_mesh,
+    extrude,
+    gap_mismatch,
+    write_polymesh,
+)
+from runs.foam_runtime import FoamRuntime
+
+R_BALL = 9.525e-3   # m
+A_HERTZ = 1.371e-4  # m
+H0 = 1e-8           # m
+R_ISLAND = 1.5 * A_HERTZ
+N_LAYERS = 6
+
+
+def hertz_gap(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Dry-Hertz-like gap h(r) (m) outside the contact (r > a)."""
+    a, R = A_HERTZ, R_BALL
+    r = np.maximum(np.hypot(x, y), a)
+    return (H0 + r**2 / (2 * R) - a**2 / R
+            + ((2 * a**2 - r**2) * np.arcsin(a / r) + a * np.sqrt(r**2 - a**2)) / (np.pi * R))
+
+
+def sizer(scale: float):
+    """size(x, y): 0.04 a at the island growing linearly to 0.4 a, times scale (m)."""
+    def size(x, y):
+        r = np.hypot(x, y)
+        return scale * np.clip(0.04 * A_HERTZ * r / R_ISLAND, 0.04 * A_HERTZ, 0.4 * A_HERTZ)
+    return size
+
+
+def params(symmetric: bool = True, **kw) -> MeshParams:
+    base = dict(x_min=-6 * A_HERTZ, x_max=12 * A_HERTZ, y_max=6 * A_HERTZ,
+                island_radius=R_ISLAND, n_layers=N_LAYERS, symmetric=symmetric)
+    base.update(kw)
+    return MeshParams(**base)
+
+
+def gap_integral(p: MeshParams, gap=hertz_gap, n: int = 200) -> float:
+    """Integral of gap over the domain (m^3), Gauss-Legendre in polar
+    coordinates (r from the island to the rectangle, theta split at the corners)."""
+    corners = sorted({math.atan2(y, x) for x in (p.x_min, p.x_max) for y in (p.y_min, p.y_max)})
+    t_lo = 0.0 if p.symmetric else -math.pi
+    cuts = [t_lo] + [t for t in corners if t_lo < t < math.pi] + [math.pi]
+    g, w = np.polynomial.legendre.leggauss(n)
+    total = 0.0
+    for t0, t1 in zip(cuts[:-1], cuts[1:]):
+        t = 0.5 * (t1 - t0) * g + 0.5 * (t1 + t0)
+        wt = 0.5 * (t1 - t0) * w
+        c, s = np.cos(t), np.sin(t)
+        with np.errstate(divide="ignore"):
+            rx = np.where(c > 0, p.x_max / c, np.where(c < 0, p.x_min / c, np.inf))
+            ry = np.where(s > 0, p.y_max / s, np.where(s < 0, p.y_min / s, np.inf))
+        r_out = np.minimum(rx, ry)
+        r = p.island_radius + (r_out - p.island_radius)[:, None] * 0.5 * (g + 1)[None, :]
+        wr = (r_out - p.island_radius)[:, None] * 0.5 * w[None, :]
+        total += float(np.sum(wt[:, None] * wr * r * gap(r * c[:, None], r * s[:, None])))
+    return total
+
+
+# ------------------------------------------------------------------ fixtures
+@pytest.fixture(scope="module")
+def coarse_base() -> BaseMesh:
+    return build_base_mesh(params(), sizer(2.0))
+
+
+@pytest.fixture(scope="module")
+def coarse(coarse_base: BaseMesh) -> PolyMesh:
+    return extrude(coarse_base, hertz_gap, N_LAYERS)
+
+
+@pytest.fixture(scope="module")
+def reference() -> PolyMesh:
+    """The realistic mesh at the reference resolution (~43k cells)."""
+    return extrude(build_base_mesh(params(), sizer(1.0)), hertz_gap, N_LAYERS)
+
+
+@pytest.fixture(scope="module")
+def runtime() -> FoamRuntime:
+    rt = FoamRuntime.from_environment()
+    rt.ensure_present()  # fails (does not skip): ./Alltest installs it
+    return rt
+
+
+def write_case(mesh: PolyMesh, case: Path) -> Path:
+    """A minimal OpenFOAM case around ``mesh``."""
+    write_polymesh(mesh, case)
+    system = case / "system"
+    system.mkdir(parents=True, exist_ok=True)
+    head = "FoamFile {{ version 2.0; format ascii; class dictionary; object {}; }}\n"
+    (system / "controlDict").write_text(
+        head.format("controlDict")
+        + "application interFoam; startFrom startTime; startTime 0; stopAt endTime;\n"
+          "endTime 1; deltaT 1; writeControl timeStep; writeInterval 1;\n")
+    (system / "fvSchemes").write_text(
+        head.format("fvSchemes")
+        + "ddtSchemes { default Euler; } gradSchemes { default Gauss linear; }\n"
+          "divSchemes { default none; } laplacianSchemes { default Gauss linear corrected; }\n"
+          "interpolationSchemes { default linear; } snGradSchemes { default corrected; }\n")
+    (system / "fvSolution").write_text(head.format("fvSolution"))
+    return case
+
+
+def check_mesh(runtime: FoamRuntime, case: Path) -> dict[str, float]:
+    """Run checkMesh; assert "Mesh OK."; return its headline numbers."""
+    out = runtime.run("checkMesh", [], cwd=case, log_path=case / "log.checkMesh").stdout
+    assert "Mesh OK." in out, out[-3000:]
+    assert "Failed" not in out, out[-3000:]
+
+    def number(pattern: str) -> float:
+        m = re.search(pattern.replace("NUM", r"([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)"), out)
+        assert m, f"{pattern!r} not in checkMesh output"
+        return float(m.group(1))
+
+    stats = {
+        "cells": number(r"\n\s*cells:\s+NUM"),
+        "max_aspect_ratio": number(r"Max aspect ratio = NUM"),
+        "max_non_orthogonality": number(r"Mesh non-orthogonality Max: NUM"),
+        "max_skewness": number(r"Max skewness = NUM"),
+        "total_volume": number(r"Total volume = NUM"),
+    }
+    print(f"\ncheckMesh {case.name}: {stats}")
+    return stats
+
+
+# ------------------------------------------------------------------ base mesh
+def test_base_mesh_is_all_quad_counter_clockwise(coarse_base: BaseMesh) -> None:
+    b, p = coarse_base, params()
+    assert b.quads.shape[1] == 4 and b.n_quads > 500
+    assert np.all(b.quad_areas() > 0)
+    assert np.array_equal(np.unique(b.quads), np.arange(b.n_points))  # no unused nodes
+    assert b.quad_areas().sum() == pytest.approx(p.area, rel=2e-3)   # polygonal island
+    assert set(b.edges) == {"island", "inlet", "outlet", "side", "symmetry"}
+
+
+def test_base_mesh_boundary_edges_lie_on_their_boundary_quad_on_left(
+        coarse_base: BaseMesh) -> None:
+    b, p = coarse_base, params()
+    outward = {"inlet": (-1.0, 0.0), "outlet": (1.0, 0.0), "side": (0.0, 1.0),
+               "symmetry": (0.0, -1.0)}
+    n_boundary = 0
+    for name, e in b.edges.items():
+        pa, pb = b.points[e[:, 0]], b.points[e[:, 1]]
+        d = pb - pa
+        normal = np.stack([d[:, 1], -d[:, 0]], axis=1)   # right of a->b: out of the quad
+        mid = 0.5 * (pa + pb)
+        direction = -mid if name == "island" else np.array(outward[name])
+        assert np.all(np.sum(normal * direction, axis=1) > 0), name
+        n_boundary += len(e)
+    pts = b.points
+    assert np.all(pts[np.unique(b.edges["inlet"]), 0] == p.x_min)
+    assert np.all(pts[np.unique(b.edges["outlet"]), 0] == p.x_max)
+    assert np.all(pts[np.unique(b.edges["side"]), 1] == p.y_max)
+    assert np.all(pts[np.unique(b.edges["symmetry"]), 1] == 0.0)
+    r = np.hypot(*pts[np.unique(b.edges["island"])].T)
+    assert np.allclose(r, p.island_radius, rtol=1e-12, atol=0)
+    # every boundary edge (edges used by one quad) is in exactly one patch
+    a, c = b.quads.ravel(), np.roll(b.quads, -1, axis=1).ravel()
+    keys, counts = np.unique(np.minimum(a, c) * b.n_points + np.maximum(a, c), return_counts=True)
+    assert n_boundary == np.sum(counts == 1)
+
+
+def test_base_mesh_follows_size_and_island_is_smooth(coarse_base: BaseMesh) -> None:
+    b = coarse_base
+    e = b.edges["island"]
+    seg = np.linalg.norm(b.points[e[:, 1]] - b.points[e[:, 0]], axis=1)
+    target = sizer(2.0)(0.0, R_ISLAND)
+    assert np.median(seg) == pytest.approx(target, rel=0.3)
+    # the island polygon has many sides: the arc is resolved
+    assert len(e) >= 30
+    # cells far away are coarser than at the island
+    c = b.points[b.quads].mean(axis=1)
+    far = np.hypot(*c.T) > 8 * A_HERTZ
+    assert np.sqrt(b.quad_areas()[far]).mean() > 5 * np.median(seg)
+
+
+def test_base_mesh_is_deterministic(coarse_base: BaseMesh) -> None:
+    again = build_base_mesh(params(), sizer(2.0))
+    assert np.array_equal(again.points, coarse_base.points)
+    assert np.array_equal(again.quads, coarse_base.quads)
+    assert all(np.array_equal(again.edges[k], coarse_base.edges[k]) for k in coarse_base.edges)
+    assert not gmsh.isInitialized()
+
+
+# ------------------------------------------------------------------ polyMesh
+def test_polymesh_topology_invariants(coarse: PolyMesh, coarse_base: BaseMesh) -> None:
+    m = coarse
+    n_int, n_faces, n_cells = m.n_internal_faces, len(m.faces), m.n_cells
+    assert n_cells == coarse_base.n_quads * N_LAYERS
+    assert len(m.points) == coarse_base.n_points * (N_LAYERS + 1)
+    own, nei = m.owner, m.neighbour
+    assert np.all(own[:n_int] < nei)
+    order = np.lexsort((nei, own[:n_int]))
+    assert np.array_equal(order, np.arange(n_int))                      # upper-triangular
+    assert np.all(np.bincount(np.r_[own, nei], minlength=n_cells) == 6)  # hexahedra
+    assert own.min() == 0 and own.max() == n_cells - 1
+    # patches: contiguous, in PATCH_TYPES order, covering all boundary faces
+    assert [p.name for p in m.patches] == [k for k in PATCH_TYPES]
+    assert all(p.type == PATCH_TYPES[p.name] for p in m.patches)
+    assert m.patches[0].start == n_int
+    for p, q in zip(m.patches[:-1], m.patches[1:]):
+        assert q.start == p.start + p.size
+    assert sum(p.size for p in m.patches) == n_faces - n_int
+    assert m.patch("disc").size == m.patch("ball").size == coarse_base.n_quads
+    assert m.patch("island").size == len(coarse_base.edges["island"]) * N_LAYERS
+    # every face has 4 distinct points
+    assert np.all(np.sort(m.faces, axis=1)[:, 1:] != np.sort(m.faces, axis=1)[:, :-1])
+    assert np.array_equal(m.base_cell * N_LAYERS + m.layer, np.arange(n_cells))
+
+
+def test_polymesh_cells_closed_volumes_positive_and_total(coarse: PolyMesh) -> None:
+    m = coarse
+    n_int = m.n_internal_faces
+    closure = np.zeros((m.n_cells, 3))
+    scale = np.zeros(m.n_cells)
+    mag = np.linalg.norm(m.face_areas, axis=1)
+    for d in range(3):
+        closure[:, d] = (np.bincount(m.owner, m.face_areas[:, d], m.n_cells)
+                         - np.bincount(m.neighbour, m.face_areas[:n_int, d], m.n_cells))
+    scale = np.bincount(m.owner, mag, m.n_cells) + np.bincount(m.neighbour, mag[:n_int], m.n_cells)
+    assert np.max(np.linalg.norm(closure, axis=1) / scale) < 1e-10
+    assert np.all(m.cell_volumes > 0)
+    exact = gap_integral(params())
+    assert m.cell_volumes.sum() == pytest.approx(exact, rel=0.01)
+    # cell centres inside their column, layers ordered upwards
+    h = hertz_gap(m.cell_centres[:, 0], m.cell_centres[:, 1])
+    z = m.cell_centres[:, 2] / h
+    assert np.all(np.abs(z - (m.layer + 0.5) / N_LAYERS) < 0.05)
+
+
+def test_polymesh_normals_point_from_owner_to_neighbour_and_out(coarse: PolyMesh) -> None:
+    m = coarse
+    n_int = m.n_internal_faces
+    d = m.cell_centres[m.neighbour] - m.cell_centres[m.owner[:n_int]]
+    assert np.all(np.sum(d * m.face_areas[:n_int], axis=1) > 0)
+    out = m.face_centres[n_int:] - m.cell_centres[m.owner[n_int:]]
+    assert np.all(np.sum(out * m.face_areas[n_int:], axis=1) > 0)
+    expected = {"disc": (2, -1), "ball": (2, 1), "inlet": (0, -1), "outlet": (0, 1),
+                "side": (1, 1), "symmetry": (1, -1)}
+    for name, (axis, sign) in expected.items():
+        sf = m.face_areas[m.patch_slice(name)]
+        assert np.all(sign * sf[:, axis] > 0.9 * np.linalg.norm(sf, axis=1) * (axis != 2)
+                      + 0.95 * np.linalg.norm(sf, axis=1) * (axis == 2)), name
+    isl = m.patch_slice("island")
+    radial = m.face_centres[isl, :2]
+    assert np.all(np.sum(radial * m.face_areas[isl, :2], axis=1) < 0)   # into the hole
+    disc = m.face_centres[m.patch_slice("disc")]
+    assert np.all(disc[:, 2] == 0)
+
+
+def test_gap_mismatch_small_at_reference_resolution(reference: PolyMesh) -> None:
+    assert 10_000 < reference.n_cells < 60_000
+    err = gap_mismatch(reference, hertz_gap)
+    print(f"\ngap_mismatch (reference, {reference.n_cells} cells) = {err:.3g}")
+    assert err < 0.01
+    ball = reference.face_centres[reference.patch_slice("ball")]
+    assert np.allclose(ball[:, 2], hertz_gap(ball[:, 0], ball[:, 1]), rtol=0.01)
+
+
+# ------------------------------------------------------------------ writer + OpenFOAM
+def test_write_polymesh_files(coarse: PolyMesh, tmp_path: Path) -> None:
+    poly = tmp_path / "constant" / "polyMesh"
+    poly.mkdir(parents=True)
+    (poly / "points.gz").write_bytes(b"stale")
+    (poly / "cellZones").write_text("stale")
+    write_polymesh(coarse, tmp_path)
+    assert sorted(f.name for f in poly.iterdir()) == [
+        "boundary", "faces", "neighbour", "owner", "points"]
+    owner = (poly / "owner").read_text()
+    assert "class       labelList;" in owner
+    assert (f'note        "nPoints:{len(coarse.points)}  nCells:{coarse.n_cells}  '
+            f'nFaces:{len(coarse.faces)}  nInternalFaces:{coarse.n_internal_faces}";') in owner
+    assert "class       vectorField;" in (poly / "points").read_text()
+    assert "class       faceList;" in (poly / "faces").read_text()
+    boundary = (poly / "boundary").read_text()
+    assert "class       polyBoundaryMesh;" in boundary
+    assert "symmetryPlane;" in boundary and "empty" not in boundary
+    # points read back to 12 significant digits
+    text = (poly / "points").read_text()
+    body = text[text.index("\n(\n") + 3:text.rindex("\n)\n")]
+    back = np.array(body.replace("(", "").replace(")", "").split(), dtype=float).reshape(-1, 3)
+    assert np.allclose(back, coarse.points, rtol=1e-11, atol=0)
+    faces = (poly / "faces").read_text()
+    first = faces[faces.index("\n(\n") + 3:].split("\n", 1)[0]
+    assert first == "4(%d %d %d %d)" % tuple(coarse.faces[0])
+
+
+def test_checkmesh_ok_on_realistic_mesh(reference: PolyMesh, runtime: FoamRuntime,
+                                        tmp_path: Path) -> None:
+    case = write_case(reference, tmp_path / "reference")
+    stats = check_mesh(runtime, case)
+    assert stats["cells"] == reference.n_cells
+    assert stats["total_volume"] == pytest.approx(reference.cell_volumes.sum(), rel=1e-5)
+
+
+def test_full_domain_is_the_half_mirrored(coarse: PolyMesh, coarse_base: BaseMesh,
+                                           runtime: FoamRuntime, tmp_path: Path) -> None:
+    p_full = params(symmetric=False)
+    base = build_base_mesh(p_full, sizer(2.0))          # even size: half mesh + mirror image
+    assert base.n_quads == 2 * coarse_base.n_quads
+    pts = base.points
+    order, order_mirrored = np.lexsort(pts.T[::-1]), np.lexsort((pts * [1, -1]).T[::-1])
+    assert np.array_equal(pts[order], (pts * [1, -1])[order_mirrored])
+    full = extrude(base, hertz_gap, N_LAYERS)
+    assert [p.name for p in full.patches] == ["disc", "ball", "island", "inlet", "outlet",
+                                              "side"]
+    assert full.n_cells == 2 * coarse.n_cells
+    assert full.cell_volumes.sum() == pytest.approx(2 * coarse.cell_volumes.sum(), rel=1e-9)
+    assert full.cell_volumes.sum() == pytest.approx(gap_integral(p_full), rel=0.01)
+    y = full.face_centres[full.patch_slice("side"), 1]
+    assert np.allclose(np.abs(y), p_full.y_max, rtol=1e-12, atol=0)
+    assert (y > 0).sum() == (y < 0).sum() > 0
+    assert full.patch("island").size == 2 * coarse.patch("island").size
+    assert gap_mismatch(full, hertz_gap) == pytest.approx(gap_mismatch(coarse, hertz_gap))
+    check_mesh(runtime, write_case(full, tmp_path / "full"))
+
+
+def test_full_domain_with_uneven_size_is_meshed_whole(runtime: FoamRuntime,
+                                                      tmp_path: Path) -> None:
+    p_full = params(symmetric=False)
+
+    def uneven(x, y):                       # coarser for y < 0
+        return sizer(2.0)(x, y) * np.where(y < 0, 1.5, 1.0)
+    base = build_base_mesh(p_full, uneven)
+    upper = base.points[base.quads].mean(axis=1)[:, 1] > 0
+    assert upper.sum() > 1.5 * (~upper).sum()
+    assert base.quad_areas().sum() == pytest.approx(p_full.area, rel=2e-3)
+    full = extrude(base, hertz_gap, N_LAYERS)
+    assert "symmetry" not in [p.name for p in full.patches]
+    assert full.cell_volumes.sum() == pytest.approx(gap_integral(p_full), rel=0.01)
+    check_mesh(runtime, write_case(full, tmp_path / "uneven"))
+
+
+# ------------------------------------------------------------------ bad input
+@pytest.mark.parametrize("change, word", [
+    (dict(island_radius=-1e-4), "island_radius"),
+    (dict(island_radius=float("nan")), "island_radius"),
+    (dict(x_min=-1e-4), "x_min"),
+    (dict(x_max=1e-4), "x_max"),
+    (dict(y_max=2e-4), "y_max"),
+    (dict(x_min="left"), "x_min"),
+    (dict(n_layers=0), "n_layers"),
+    (dict(n_layers=2.5), "n_layers"),
+    (dict(symmetric="yes"), "symmetric"),
+])
+def test_bad_params_raise_value_error_naming_them(change: dict, word: str) -> None:
+    with pytest.raises(ValueError, match=word):
+        params(**change)
+
+
+def test_bad_size_raises_value_error() -> None:
+    with pytest.raises(ValueError, match=r"size\(x, y\) must be a positive finite"):
+        build_base_mesh(params(), lambda x, y: np.where(x > 0, -1.0, 1e-5))
+    with pytest.raises(ValueError, match="max_quads"):
+        build_base_mesh(params(), lambda x, y: np.full(np.shape(x), 1e-8))   # too fine
+    with pytest.raises(ValueError, match="size"):
+        build_base_mesh(params(), 1e-5)
+    assert not gmsh.isInitialized()
+
+
+def test_size_failing_inside_gmsh_leaves_no_gmsh_state() -> None:
+    def scalar_hostile(x, y):
+        if np.ndim(x) == 0:
+            raise RuntimeError("no scalars please")
+        return np.full(np.shape(x), 2e-5)
+    with pytest.raises(ValueError, match="no scalars please"):
+        build_base_mesh(params(), scalar_hostile)
+    assert not gmsh.isInitialized()
+
+
+def test_caller_gmsh_session_is_left_as_it_was(coarse_base: BaseMesh) -> None:
+    gmsh.initialize([], readConfigFiles=False, interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("callers")
+        gmsh.option.setNumber("Mesh.Algorithm", 5)
+        b = build_base_mesh(params(), sizer(2.0))
+        assert gmsh.model.getCurrent() == "callers"
+        assert gmsh.option.getNumber("Mesh.Algorithm") == 5
+        assert np.array_equal(b.quads, coarse_base.quads)
+    finally:
+        gmsh.finalize()
+
+
+def test_bad_gap_and_layers_raise_value_error(coarse_base: BaseMesh) -> None:
+    def holed(x, y):
+        h = hertz_gap(x, y)
+        return np.where(x > 10 * A_HERTZ, np.nan, h)
+    with pytest.raises(ValueError, match=r"gap must be > 0 and finite.*gap\(0\.00"):
+        extrude(coarse_base, holed, N_LAYERS)
+    with pytest.raises(ValueError, match="gap must be > 0"):
+        extrude(coarse_base, lambda x, y: hertz_gap(x, y) - 1e-6, N_LAYERS)
+    with pytest.raises(ValueError, match="n_layers"):
+        extrude(coarse_base, hertz_gap, 0)
+    bad = BaseMesh(coarse_base.points, coarse_base.quads[:, ::-1], coarse_base.edges)
+    with pytest.raises(ValueError, match="counter-clockwise"):
+        extrude(bad, hertz_gap, N_LAYERS)
+    partial = BaseMesh(coarse_base.points, coarse_base.quads,
+                       {k: v for k, v in coarse_base.edges.items() if k != "inlet"})
+    with pytest.raises(ValueError, match="exactly one patch"):
+        extrude(partial, hertz_gap, N_LAYERS)
