@@ -26,7 +26,8 @@ from runs.foam_runtime import FoamRuntime
 
 from .case_spec import CaseSpec
 from .gap_source import load_gap
-from .mesh import MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch, write_polymesh
+from .mesh import (MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
+                   split_patch, write_polymesh)
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
 META = "ehlfoam"  # the case's own folder of generator outputs
@@ -112,7 +113,7 @@ def _overlap(lo, hi, a, b):
 def oil_fraction(spec: CaseSpec, y, z_lo, z_hi, gap_h, on_track) -> np.ndarray:
     """Oil fraction of cells or faces spanning z in [z_lo, z_hi] of a column of gap gap_h [m]:
     the supply layers on the disc and the ball ("layers") or the whole height ("flooded"),
-    only where ``on_track``."""
+    times ``on_track`` (bool, or the fraction of the face on the track)."""
     s = spec.supply
     span = np.maximum(z_hi - z_lo, 1e-300)
     if s.mode == "flooded":
@@ -121,7 +122,7 @@ def oil_fraction(spec: CaseSpec, y, z_lo, z_hi, gap_h, on_track) -> np.ndarray:
         disc = _overlap(z_lo, z_hi, 0.0, np.minimum(s.disc_layer, gap_h))
         ball = _overlap(z_lo, z_hi, np.maximum(gap_h - s.ball_layer, s.disc_layer), gap_h)
         frac = (disc + ball) / span
-    return np.where(on_track, np.clip(frac, 0.0, 1.0), 0.0)
+    return np.clip(frac, 0.0, 1.0) * np.asarray(on_track, dtype=float)
 
 
 def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
@@ -139,33 +140,39 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     return np.where(puddle, 1.0, alpha)
 
 
-def patch_faces(mesh: PolyMesh, name: str) -> slice:
-    for p in mesh.patches:
-        if p.name == name:
-            return slice(p.start, p.start + p.size)
-    raise KeyError(f"mesh has no patch {name!r}")
-
-
-def inlet_alpha(spec: CaseSpec, mesh: PolyMesh) -> np.ndarray:
-    """inletValue of alpha.oil on the inlet faces: the supply, on the track only."""
+def supply_fraction(spec: CaseSpec, mesh: PolyMesh, patch: str = "inlet") -> np.ndarray:
+    """Oil fraction of each face of ``patch`` in the supply: the part of the face inside the
+    oil layers (or the whole face, flooded) on the track; 0 elsewhere and for single-phase."""
+    faces = mesh.faces[mesh.patch_slice(patch)]
     if spec.scene == "single-phase":
-        return np.ones(patch_faces(mesh, "inlet").stop - patch_faces(mesh, "inlet").start)
-    faces = mesh.faces[patch_faces(mesh, "inlet")]
-    z = mesh.points[faces, 2]
+        return np.zeros(len(faces))
+    # a face is a vertical trapezoid: its bottom and top are the means of its two lower and
+    # two upper corners, so that the supplied area is exact
+    z = np.sort(mesh.points[faces, 2], axis=1)
     y = mesh.points[faces, 1].mean(axis=1)
-    z_lo, z_hi = z.min(axis=1), z.max(axis=1)
-    # the column height at the face: the highest point of the face's column
-    gap_h = np.full_like(z_hi, np.nan)
-    for key in np.unique(np.round(y, 12)):
-        sel = np.round(y, 12) == key
-        gap_h[sel] = z_hi[sel].max()
-    on_track = np.abs(y) < spec.supply.track_half_width
-    return oil_fraction(spec, y, z_lo, z_hi, gap_h, on_track)
+    z_lo, z_hi = z[:, :2].mean(axis=1), z[:, 2:].mean(axis=1)
+    # the column height at each face: the highest point of the faces at the same y
+    key = np.round(y, 12)
+    _, inverse = np.unique(key, return_inverse=True)
+    column = np.zeros(inverse.max() + 1)
+    np.maximum.at(column, inverse, z_hi)
+    # the part of each face's width on the track, so that the supply's width is exact
+    w = spec.supply.track_half_width
+    y_lo, y_hi = mesh.points[faces, 1].min(axis=1), mesh.points[faces, 1].max(axis=1)
+    on_track = _overlap(y_lo, y_hi, -w, w) / np.maximum(y_hi - y_lo, 1e-300)
+    return oil_fraction(spec, y, z_lo, z_hi, column[inverse], on_track)
+
+
+def with_supply_patch(spec: CaseSpec, mesh: PolyMesh) -> PolyMesh:
+    """Split the inlet: faces that carry oil in become the ``supply`` patch (fixed inflow at
+    the rolling speed), the rest stays an open boundary at ambient pressure."""
+    frac = supply_fraction(spec, mesh)
+    return split_patch(mesh, "inlet", frac > 1e-6, "supply")
 
 
 def island_velocity(spec: CaseSpec, mesh: PolyMesh) -> np.ndarray:
     """Velocity of the island faces: (u, 0, 0) projected on the wall (no through-flow)."""
-    sl = patch_faces(mesh, "island")
+    sl = mesh.patch_slice("island")
     n = mesh.face_areas[sl] / np.linalg.norm(mesh.face_areas[sl], axis=1, keepdims=True)
     u = np.array([spec.speed if spec.walls_moving else 0.0, 0.0, 0.0])
     return u - n * (n @ u)[:, None]
@@ -179,19 +186,40 @@ def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, gap, geom: CaseGeom
         f.boundary_field["ball"]["origin"] = np.array([0.0, 0.0, spec.contact.radius])
         f.boundary_field["ball"]["omega"] = -u / spec.contact.radius
         f.boundary_field["island"]["value"] = island_velocity(spec, mesh)
+        f.boundary_field["supply"]["value"] = np.array([u, 0.0, 0.0])
         if not geom.symmetric:
             del f.boundary_field["symmetry"]
     with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
         f.internal_field = initial_alpha(spec, mesh, gap)
         f.boundary_field['"(disc|ball|island)"']["theta0"] = spec.physics.contact_angle
-        f.boundary_field["inlet"]["inletValue"] = inlet_alpha(spec, mesh)
+        supply = None
+        if any(p.name == "supply" for p in mesh.patches):
+            supply = supply_fraction(spec, mesh, "supply")
+            f.boundary_field["supply"]["value"] = (supply if len(supply) not in (3, 6, 9)
+                                                   else _PLACEHOLDER)
         if spec.scene == "single-phase":
-            f.boundary_field['"(outlet|side)"']["inletValue"] = 1.0
+            f.boundary_field['"(inlet|outlet|side)"']["inletValue"] = 1.0
         if not geom.symmetric:
             del f.boundary_field["symmetry"]
+    if supply is not None and len(supply) in (3, 6, 9):
+        _write_scalar_list(case / "0.orig" / "alpha.oil", supply)
     if not geom.symmetric:
         with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
             del f.boundary_field["symmetry"]
+
+
+#: foamlib (1.7) writes a scalar list of 3, 6 or 9 values as a uniform vector or tensor; such
+#: lists are written through this placeholder instead.
+_PLACEHOLDER = 7.123456789e33
+
+
+def _write_scalar_list(path: Path, values: np.ndarray) -> None:
+    text = path.read_text()
+    body = " ".join(repr(float(v)) for v in values)
+    marker = f"uniform {_PLACEHOLDER!r}"
+    if marker not in text:
+        raise RuntimeError(f"placeholder for a {len(values)}-value list not found in {path}")
+    path.write_text(text.replace(marker, f"nonuniform List<scalar> {len(values)}({body})"))
 
 
 def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
@@ -208,6 +236,8 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
         f["maxCo"] = spec.run.max_courant
         f["maxAlphaCo"] = spec.run.max_alpha_courant
         f["maxDeltaT"] = geom.max_delta_t
+    with FoamFile(case / "system" / "fvSolution") as f:
+        f["solvers"]['"alpha.oil.*"']["cAlpha"] = spec.physics.interface_compression
     with FoamFile(case / "system" / "decomposeParDict") as f:
         f["numberOfSubdomains"] = spec.run.n_procs
 
@@ -242,6 +272,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
                         island_radius=d.island_radius * a, n_layers=level["n_layers"],
                         symmetric=d.symmetry == "half")
     mesh = extrude(build_base_mesh(params, size_function(spec)), gap, level["n_layers"])
+    mesh = with_supply_patch(spec, mesh)
     dx = level["size_rim"] * a
     dt = capillary_time_step(spec, dx)
     summary = _read_json(precalc / "summary.json")
@@ -251,8 +282,8 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         x_max=params.x_max, y_max=params.y_max, island_radius=params.island_radius,
         symmetric=params.symmetric, n_layers=params.n_layers, cells=len(mesh.cell_volumes),
         transit_time=spec.transit_time, end_time=spec.end_time,
-        write_interval=spec.transit_time / spec.run.writes_per_transit,
-        max_delta_t=min(dt, spec.transit_time / spec.run.writes_per_transit),
+        write_interval=_write_interval(spec),
+        max_delta_t=min(dt, _write_interval(spec)),
         capillary_limit=spec.run.capillary_limit, min_cell_size=dx,
         island_gap=float(gap(np.array([params.island_radius]), np.array([0.0]))[0]),
         hc=hc, contact_flow=spec.speed * hc * 2.0 * a,
@@ -280,6 +311,12 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return geom
+
+
+def _write_interval(spec: CaseSpec) -> float:
+    """transit time / writes_per_transit, shortened so that the end time is a write time."""
+    nominal = spec.transit_time / spec.run.writes_per_transit
+    return spec.end_time / math.ceil(spec.end_time / nominal - 1e-9)
 
 
 def _template_for(spec: CaseSpec) -> str:

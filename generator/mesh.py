@@ -739,6 +739,37 @@ def extrude(base: BaseMesh, gap: GapFunction, n_layers: int) -> PolyMesh:
                     base_cell=cells // L, layer=cells % L, face_centres=fc, face_areas=sf)
 
 
+def split_patch(mesh: PolyMesh, name: str, select: np.ndarray, new_name: str,
+                new_type: str = "patch") -> PolyMesh:
+    """A copy of ``mesh`` in which the faces of patch ``name`` where ``select`` (bool, one per
+    face of the patch) form a new patch ``new_name`` placed right after it. Faces are only
+    reordered within the old patch's range, so the rest of the mesh is unchanged."""
+    sl = mesh.patch_slice(name)
+    select = np.asarray(select, dtype=bool)
+    if select.shape != (sl.stop - sl.start,):
+        raise ValueError(f"select must have one entry per face of {name!r} "
+                         f"({sl.stop - sl.start}), got shape {select.shape}")
+    if any(p.name == new_name for p in mesh.patches):
+        raise ValueError(f"patch {new_name!r} exists already")
+    order = np.r_[np.flatnonzero(~select), np.flatnonzero(select)] + sl.start
+    perm = np.arange(len(mesh.faces))
+    perm[sl] = order
+    patches = []
+    for p in mesh.patches:
+        if p.name != name:
+            patches.append(p)
+            continue
+        kept = int((~select).sum())
+        if kept:
+            patches.append(Patch(p.name, p.type, p.start, kept))
+        if select.any():
+            patches.append(Patch(new_name, new_type, p.start + kept, int(select.sum())))
+    return PolyMesh(points=mesh.points, faces=mesh.faces[perm], owner=mesh.owner[perm],
+                    neighbour=mesh.neighbour, patches=patches, cell_centres=mesh.cell_centres,
+                    cell_volumes=mesh.cell_volumes, base_cell=mesh.base_cell, layer=mesh.layer,
+                    face_centres=mesh.face_centres[perm], face_areas=mesh.face_areas[perm])
+
+
 def gap_mismatch(mesh: PolyMesh, gap: GapFunction) -> float:
     """Largest relative error of the mesh's gap height on the ball:
     max over ``ball`` faces of \\|z(face centre) - h(x, y)\\| / h(x, y) (the

@@ -19,7 +19,7 @@ from generator.case_writer import META, CaseGeometry
 
 from . import metrics
 
-OPEN_PATCHES = ("inlet", "outlet", "side")
+OPEN_PATCHES = ("supply", "inlet", "outlet", "side")
 
 
 @dataclass
