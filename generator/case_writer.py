@@ -240,6 +240,7 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
         f["solvers"]['"alpha.oil.*"']["cAlpha"] = spec.physics.interface_compression
     with FoamFile(case / "system" / "decomposeParDict") as f:
         f["numberOfSubdomains"] = spec.run.n_procs
+        f["coeffs"]["n"] = [spec.run.n_procs, 1, 1]
 
 
 def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int) -> None:
@@ -249,7 +250,9 @@ def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int) -> None:
     values = {"@FOAM_LAUNCH@": shlex.join(argv[:-1]),
               "@FOAM_BIN@": str(app_path.parent) if app_path.is_absolute() else "",
               "@WM_PROJECT_DIR@": runtime.env({}).get("WM_PROJECT_DIR", ""),
-              "@NPROCS@": str(n_procs)}
+              "@NPROCS@": str(n_procs),
+              "@PARALLEL_INTERFOAM@": shlex.join(runtime.mpi_command("interFoam", n_procs, "."))
+              if n_procs > 1 else "false  # serial case"}
     text = (case / "Allrun").read_text()
     for key, value in values.items():
         text = text.replace(key, value)

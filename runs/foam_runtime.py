@@ -209,6 +209,38 @@ class FoamRuntime:
             return [app, *argv]
         return [*self.prefix, app, *argv]
 
+    def mpi_command(self, app: str, n_procs: int, case: str | os.PathLike[str],
+                    *args: str) -> list[str]:
+        """The argv that runs ``app -parallel`` on ``n_procs`` MPI ranks in ``case``.
+
+        native/prefix: ``mpirun --oversubscribe -np N <command> -parallel`` (the user's mpirun).
+        embedded: Debian 13's mpirun cannot be driven through the loader, so the run happens
+        in a chroot of the runtime, in a private mount namespace (``unshare -m``) where the
+        case is bind-mounted at ``/mnt``; the mounts vanish with the process. Needs root.
+        ``case`` may be relative to the process's working folder (e.g. "." in a script).
+        """
+        if n_procs < 2:
+            raise FoamConfigError(f"n_procs = {n_procs}: an MPI run needs at least 2 ranks")
+        if self.kind != "embedded":
+            return ["mpirun", "--oversubscribe", "-np", str(n_procs),
+                    *self.command(app, *args), "-parallel"]
+        if os.geteuid() != 0:
+            raise FoamConfigError(
+                "parallel runs with the embedded OpenFOAM need root (a chroot into the "
+                "runtime); run serially (run.n_procs = 1) or set EHLFOAM_FOAM=native/prefix")
+        root = self._root()
+        allow = " ".join(f"{k}=1" for k in (
+            "OMPI_ALLOW_RUN_AS_ROOT", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM",
+            "PRTE_ALLOW_RUN_AS_ROOT", "PRTE_ALLOW_RUN_AS_ROOT_CONFIRM"))
+        inner = shlex.join(["mpirun", "--oversubscribe", "-np", str(n_procs), app, *args,
+                            "-parallel"])
+        script = (f"mount --bind {shlex.quote(str(case))} {shlex.quote(str(root / 'mnt'))} && "
+                  f"mount -t proc proc {shlex.quote(str(root / 'proc'))} && "
+                  f"exec chroot {shlex.quote(str(root))} env -i PATH=/usr/bin:/bin HOME=/root "
+                  f"WM_PROJECT_DIR=/usr/share/openfoam {allow} "
+                  f"sh -c {shlex.quote('cd /mnt && exec ' + inner)}")
+        return ["unshare", "-m", "sh", "-c", script]
+
     def command_prefix(self) -> str:
         """The command as text, with ``<app>`` for the application (for display)."""
         argv = self.command("APP")
@@ -261,9 +293,11 @@ class FoamRuntime:
         args: Sequence[str | os.PathLike[str]] = (),
         cwd: str | os.PathLike[str] = ".",
         log_path: str | os.PathLike[str] = "log",
+        n_procs: int = 1,
     ) -> subprocess.Popen:
         """Start ``app args`` in the case folder ``cwd`` without waiting, stdout and stderr
-        to ``log_path`` (relative to ``cwd``). The caller waits for or stops the process."""
+        to ``log_path`` (relative to ``cwd``); on ``n_procs`` MPI ranks (decomposed case)
+        when n_procs > 1. The caller waits for or stops the process."""
         self.ensure_present()
         case = Path(cwd).absolute()
         if not case.is_dir():
@@ -271,7 +305,8 @@ class FoamRuntime:
         if self.kind == "embedded" and not Path(self.app_path(app)).is_file():
             raise FoamError(f"OpenFOAM application {app!r} not found in the embedded runtime "
                             f"({self.app_path(app)} does not exist); case {case}")
-        argv = self.command(app, *args)
+        argv = self.command(app, *args) if n_procs < 2 else self.mpi_command(app, n_procs, case,
+                                                                             *args)
         log = case / log_path
         with open(log, "w", encoding="utf-8", errors="replace") as fh:
             try:

@@ -181,7 +181,10 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
     tail = LogTail(log_path)
     dt_floor = DT_COLLAPSE * geom.max_delta_t
     t_start = time.monotonic()
-    proc = runtime.popen("interFoam", [], cwd=case, log_path=LOG)
+    n_procs = spec.run.n_procs
+    if n_procs > 1 and not (case / "processor0").is_dir():
+        runtime.run("decomposePar", ["-force"], cwd=case, log_path=case / "log.decomposePar")
+    proc = runtime.popen("interFoam", [], cwd=case, log_path=LOG, n_procs=n_procs)
     reason, stopping_since = None, None
     previous = signal.getsignal(signal.SIGTERM)
     signal.signal(signal.SIGTERM, _raise_interrupt)
@@ -189,6 +192,8 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
         while True:
             exited = proc.poll() is not None
             tail.update(dt_floor)
+            if n_procs > 1:
+                _reconstruct_new(case, runtime)
             for _, folder in case_fields.time_folders(case):
                 if folder.name in done:
                     continue
@@ -232,6 +237,16 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
         if proc.poll() is None:
             proc.kill()
         proc.wait()
+    if n_procs > 1:   # the last writes, then one more sample pass
+        _reconstruct_new(case, runtime)
+        for _, folder in case_fields.time_folders(case):
+            if folder.name not in done:
+                try:
+                    history.append(case_fields.sample(folder, structure, geom))
+                except Exception:
+                    pass
+                done.add(folder.name)
+        _write_history(case, history)
     wall = time.monotonic() - t_start
     rc = proc.returncode
     if reason is None:
@@ -240,6 +255,16 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
     metrics = _final_metrics(spec, geom, v0, history, reason, failed, rc, tail, wall, case)
     atomic_write_json(case / "metrics.json", metrics)
     return metrics
+
+
+def _reconstruct_new(case: Path, runtime: FoamRuntime) -> None:
+    """Bring the times the ranks wrote into the case folder (reconstructPar -newTimes)."""
+    written = {p.name for p in (case / "processor0").iterdir() if p.is_dir()} \
+        if (case / "processor0").is_dir() else set()
+    have = {p.name for _, p in case_fields.time_folders(case)} | {"0", "constant"}
+    if written - have:
+        runtime.run("reconstructPar", ["-newTimes"], cwd=case,
+                    log_path=case / "log.reconstructPar", check=False)
 
 
 def _raise_interrupt(signum, frame):

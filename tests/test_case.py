@@ -7,6 +7,7 @@ the solver works on its own copy.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -227,3 +228,22 @@ def test_static_meniscus_stays_put(tmp_path):
     assert u_oil < 0.1 * spec.speed, f"spurious velocity in the oil {u_oil:.3g} m/s"
     assert m["inlet_meniscus_distance_over_a"] == pytest.approx(2.0, abs=0.1)
     assert m["oil_volume_m3"] == pytest.approx(m["oil_volume_initial_m3"], rel=1e-3)
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or shutil.which("unshare") is None,
+                    reason="parallel runs of the embedded runtime need root and unshare")
+def test_parallel_run_matches_serial(small_case, tmp_path):
+    """decomposePar + mpirun on 2 ranks: same oil volume as the serial run."""
+    spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "end_time": 3e-4, "n_procs": 2}})
+    case = tmp_path / "parallel"
+    write_case(spec, case)
+    m = run_case(case, wall_limit=300)
+    assert m["status"] == "finished" and m["end_reason"] == "end_time", m
+    assert (case / "processor1").is_dir()
+    serial = _copy(small_case, tmp_path)
+    with FoamFile(serial / "system" / "controlDict") as f:
+        f["endTime"] = 3e-4
+        f["writeInterval"] = 1e-4
+    s = run_case(serial, wall_limit=300)
+    assert m["simulated_time_s"] == pytest.approx(s["simulated_time_s"])
+    assert m["oil_volume_m3"] == pytest.approx(s["oil_volume_m3"], rel=1e-3)
