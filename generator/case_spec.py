@@ -51,9 +51,9 @@ _STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 #: In-plane cell size at the island rim and far away (units a), and cells across the gap.
 RESOLUTIONS: dict[str, dict[str, float]] = {
-    "coarse": {"size_rim": 0.12, "size_far": 0.8, "n_layers": 4},
-    "medium": {"size_rim": 0.08, "size_far": 0.55, "n_layers": 6},
-    "fine": {"size_rim": 0.055, "size_far": 0.38, "n_layers": 8},
+    "coarse": {"size_rim": 0.12, "size_far": 0.8, "n_layers": 6, "wall_grading": 3.0},
+    "medium": {"size_rim": 0.08, "size_far": 0.55, "n_layers": 8, "wall_grading": 4.0},
+    "fine": {"size_rim": 0.055, "size_far": 0.38, "n_layers": 10, "wall_grading": 5.0},
 }
 
 
@@ -138,6 +138,8 @@ class Mesh(BaseModel):
         resolution: "coarse", "medium" or "fine".
         n_layers: cells across the gap (None: the level's value).
         size_rim, size_far: in-plane cell size at the island rim / far away, units of a.
+        wall_grading: mid-gap cell height over wall cell height (1: uniform layers); finer
+            cells at the walls carry the supply layers and the films left behind.
     """
 
     model_config = _STRICT
@@ -145,11 +147,12 @@ class Mesh(BaseModel):
     n_layers: int | None = Field(None, ge=1, le=64)
     size_rim: float | None = Field(None, gt=0.0, le=10.0)
     size_far: float | None = Field(None, gt=0.0, le=50.0)
+    wall_grading: float | None = Field(None, ge=1.0, le=100.0)
 
     def level(self) -> dict[str, float]:
         """The level's sizes with the overrides applied."""
         out = dict(RESOLUTIONS[self.resolution])
-        for key in ("n_layers", "size_rim", "size_far"):
+        for key in ("n_layers", "size_rim", "size_far", "wall_grading"):
             if getattr(self, key) is not None:
                 out[key] = getattr(self, key)
         out["n_layers"] = int(out["n_layers"])

@@ -27,7 +27,7 @@ from runs.foam_runtime import FoamRuntime
 from .case_spec import CaseSpec
 from .gap_source import load_gap
 from .mesh import (MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
-                   split_patch, write_polymesh)
+                   layer_fractions, split_patch, write_polymesh)
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
 META = "ehlfoam"  # the case's own folder of generator outputs
@@ -131,11 +131,12 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     if spec.scene == "single-phase":
         return np.ones(len(mesh.cell_volumes))
     x, y = mesh.cell_centres[:, 0], mesh.cell_centres[:, 1]
-    n = spec.mesh.level()["n_layers"]
+    level = spec.mesh.level()
+    f = layer_fractions(level["n_layers"], level["wall_grading"])
     h = gap(x, y)
     k = mesh.layer
     on_track = np.abs(y) < spec.supply.track_half_width
-    alpha = oil_fraction(spec, y, h * k / n, h * (k + 1) / n, h, on_track)
+    alpha = oil_fraction(spec, y, h * f[k], h * f[k + 1], h, on_track)
     puddle = np.hypot(x, y) < spec.supply.initial_puddle * spec.a
     return np.where(puddle, 1.0, alpha)
 
@@ -252,7 +253,7 @@ def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int) -> None:
               "@WM_PROJECT_DIR@": runtime.env({}).get("WM_PROJECT_DIR", ""),
               "@NPROCS@": str(n_procs),
               "@PARALLEL_INTERFOAM@": shlex.join(runtime.mpi_command("interFoam", n_procs, "."))
-              if n_procs > 1 else "false  # serial case"}
+              if n_procs > 1 else "false"}  # the serial branch runs instead
     text = (case / "Allrun").read_text()
     for key, value in values.items():
         text = text.replace(key, value)
@@ -274,7 +275,8 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
     params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
                         island_radius=d.island_radius * a, n_layers=level["n_layers"],
                         symmetric=d.symmetry == "half")
-    mesh = extrude(build_base_mesh(params, size_function(spec)), gap, level["n_layers"])
+    mesh = extrude(build_base_mesh(params, size_function(spec)), gap, level["n_layers"],
+                   level["wall_grading"])
     mesh = with_supply_patch(spec, mesh)
     dx = level["size_rim"] * a
     dt = capillary_time_step(spec, dx)

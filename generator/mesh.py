@@ -693,12 +693,38 @@ def _cell_geometry(n_cells: int, owner: np.ndarray, neighbour: np.ndarray,
     return ctr, vol3 / 3.0
 
 
-def extrude(base: BaseMesh, gap: GapFunction, n_layers: int) -> PolyMesh:
+def layer_fractions(n_layers: int, wall_grading: float = 1.0) -> np.ndarray:
+    """Level heights as fractions of the gap, 0 .. 1 (n_layers + 1 values), symmetric about
+    mid-gap; ``wall_grading`` is the ratio of the middle cell's height to the wall cell's
+    (1: uniform). A tanh stretching, so that the growth from cell to cell is smooth; it
+    resolves oil layers and films on both walls."""
+    s = np.arange(n_layers + 1) / n_layers
+    if not wall_grading > 1.0 or n_layers < 3:
+        return s
+
+    def ratio(beta: float) -> float:
+        f = 0.5 * (1 + np.tanh(beta * (2 * s - 1)) / np.tanh(beta))
+        d = np.diff(f)
+        return d[len(d) // 2] / d[0]
+
+    lo, hi = 1e-6, 20.0
+    for _ in range(100):          # bisection: ratio grows with beta
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ratio(mid) < wall_grading else (lo, mid)
+    beta = 0.5 * (lo + hi)
+    f = 0.5 * (1 + np.tanh(beta * (2 * s - 1)) / np.tanh(beta))
+    f[0], f[-1] = 0.0, 1.0
+    return f
+
+
+def extrude(base: BaseMesh, gap: GapFunction, n_layers: int,
+            wall_grading: float = 1.0) -> PolyMesh:
     """Extrude ``base`` across the gap into ``n_layers`` layers of hexahedra.
 
     ``gap(x, y)`` is the local gap height h (m) at arrays of points (m); it
     must be > 0 and finite at every base node. Node ``i`` at level ``k``
-    sits at ``(x_i, y_i, h_i * k / n_layers)``: disc at z = 0, ball at z = h.
+    sits at ``(x_i, y_i, h_i * f_k)``: disc at z = 0, ball at z = h, with
+    f_k = k / n_layers or graded toward both walls (:func:`layer_fractions`).
     """
     L = _check_n_layers(n_layers)
     points2, quads = np.asarray(base.points, float), np.asarray(base.quads, np.int64)
@@ -711,7 +737,9 @@ def extrude(base: BaseMesh, gap: GapFunction, n_layers: int) -> PolyMesh:
         raise ValueError("base.quads must all be counter-clockwise seen from +z "
                          f"({int(np.sum(base.quad_areas() <= 0))} are not)")
     h = _gap_at_nodes(base, gap)
-    frac = np.arange(L + 1) / L
+    if not (np.isfinite(wall_grading) and 1.0 <= wall_grading <= 100.0):
+        raise ValueError(f"wall_grading must be in [1, 100], got {wall_grading!r}")
+    frac = layer_fractions(L, wall_grading)
     points = np.empty((len(points2), L + 1, 3))
     points[..., :2] = points2[:, None, :]
     points[..., 2] = h[:, None] * frac
