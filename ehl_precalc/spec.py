@@ -161,15 +161,20 @@ def make_spec(**values) -> PrecalcSpec:
         raise SpecError(f"invalid input: {_format_error(err)}") from None
 
 
-def load_spec(path: str | Path, **overrides) -> PrecalcSpec:
-    """Read a TOML spec (keys at top level or in a ``[precalc]`` table), then apply overrides."""
+def read_toml(path: str | Path) -> dict:
+    """A TOML file as a dict; :class:`SpecError` naming the file if missing or malformed."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
+        return tomllib.loads(path.read_text())
     except FileNotFoundError:
         raise SpecError(f"spec file = {str(path)!r}: no such file") from None
     except tomllib.TOMLDecodeError as err:
         raise SpecError(f"spec file = {str(path)!r}: not valid TOML ({err})") from None
+
+
+def load_spec(path: str | Path, **overrides) -> PrecalcSpec:
+    """Read a TOML spec (keys at top level or in a ``[precalc]`` table), then apply overrides."""
+    data = read_toml(path)
     data = data.get("precalc", data)
     data.update({k: v for k, v in overrides.items() if v is not None})
     return make_spec(**data)

@@ -39,13 +39,12 @@ its valid range, before anything is written.
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from ehl_precalc.spec import PrecalcSpec, SpecError
+from ehl_precalc.spec import PrecalcSpec, SpecError, read_toml
 
 _STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
@@ -343,11 +342,4 @@ def _deep_copy(data):
 
 def load_case_spec(path: str | Path, **overrides: Any) -> CaseSpec:
     """Read and validate a TOML case spec; ``overrides`` as in :func:`make_case_spec`."""
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise SpecError(f"spec file = {str(path)!r}: no such file") from None
-    except tomllib.TOMLDecodeError as err:
-        raise SpecError(f"spec file = {str(path)!r}: not valid TOML ({err})") from None
-    return make_case_spec(data, **overrides)
+    return make_case_spec(read_toml(path), **overrides)

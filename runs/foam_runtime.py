@@ -286,6 +286,20 @@ class FoamRuntime:
                 "EHLFOAM_FOAM=native but no OpenFOAM application (blockMesh) is on PATH. "
                 + _SETUP_HINT)
 
+    def _checked_case(self, app: str, cwd: str | os.PathLike[str]) -> Path:
+        """The absolute case folder, after checking the runtime, the folder and the app."""
+        self.ensure_present()
+        case = Path(cwd).absolute()
+        if not case.is_dir():
+            raise FoamError(f"{app}: case folder {case} does not exist")
+        if self.kind == "embedded" and not Path(self.app_path(app)).is_file():
+            raise FoamError(f"OpenFOAM application {app!r} not found in the embedded runtime "
+                            f"({self.app_path(app)} does not exist); case {case}")
+        if self.kind == "native" and shutil.which(app, path=self.env().get("PATH")) is None:
+            raise FoamError(f"OpenFOAM application {app!r} not found on PATH "
+                            f"(EHLFOAM_FOAM=native); case {case}")
+        return case
+
     # ----------------------------------------------------------------- start
     def popen(
         self,
@@ -298,13 +312,7 @@ class FoamRuntime:
         """Start ``app args`` in the case folder ``cwd`` without waiting, stdout and stderr
         to ``log_path`` (relative to ``cwd``); on ``n_procs`` MPI ranks (decomposed case)
         when n_procs > 1. The caller waits for or stops the process."""
-        self.ensure_present()
-        case = Path(cwd).absolute()
-        if not case.is_dir():
-            raise FoamError(f"{app}: case folder {case} does not exist")
-        if self.kind == "embedded" and not Path(self.app_path(app)).is_file():
-            raise FoamError(f"OpenFOAM application {app!r} not found in the embedded runtime "
-                            f"({self.app_path(app)} does not exist); case {case}")
+        case = self._checked_case(app, cwd)
         argv = self.command(app, *args) if n_procs < 2 else self.mpi_command(app, n_procs, case,
                                                                              *args)
         log = case / log_path
@@ -334,16 +342,7 @@ class FoamRuntime:
         last lines of the log. A missing installation or application always
         raises.
         """
-        self.ensure_present()
-        case = Path(cwd).absolute()
-        if not case.is_dir():
-            raise FoamError(f"{app}: case folder {case} does not exist")
-        if self.kind == "embedded" and not Path(self.app_path(app)).is_file():
-            raise FoamError(f"OpenFOAM application {app!r} not found in the embedded runtime "
-                            f"({self.app_path(app)} does not exist); case {case}")
-        if self.kind == "native" and shutil.which(app, path=self.env().get("PATH")) is None:
-            raise FoamError(f"OpenFOAM application {app!r} not found on PATH "
-                            f"(EHLFOAM_FOAM=native); case {case}")
+        case = self._checked_case(app, cwd)
         argv = self.command(app, *args)
         log = Path(log_path).absolute() if log_path is not None else None
         try:
