@@ -108,9 +108,23 @@ def mid_gap_alpha(folder: Path, structure: Structure, geom: CaseGeometry) -> np.
     return structure.mid_gap(alpha, geom.n_layers)
 
 
+def _complete(path: Path) -> Path:
+    """``path`` if OpenFOAM finished writing it (its closing banner is there), else raise:
+    a truncated list can send a regex-based parser into endless backtracking."""
+    with open(path, "rb") as fh:
+        fh.seek(0, 2)
+        fh.seek(max(0, fh.tell() - 200))
+        if b"// ****" not in fh.read():
+            raise ValueError(f"{path} is incomplete (still being written?)")
+    return path
+
+
 def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     """Read one time folder. Raises (OSError, ValueError, KeyError...) while the folder is
     still being written; the caller retries."""
+    for name in ("alpha.oil", "phi", "alphaPhi0.oil"):
+        if (folder / name).exists() or name == "alpha.oil":
+            _complete(folder / name)
     n = len(structure.cell_volumes)
     alpha_file = FoamFieldFile(folder / "alpha.oil")
     alpha = _uniform_or_list(alpha_file.internal_field, n)

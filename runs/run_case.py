@@ -194,9 +194,14 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
             tail.update(dt_floor)
             if n_procs > 1:
                 _reconstruct_new(case, runtime)
-            for _, folder in case_fields.time_folders(case):
+            folders = case_fields.time_folders(case)
+            for k, (_, folder) in enumerate(folders):
                 if folder.name in done:
                     continue
+                # a folder is read once the solver has moved on to the next one (or ended):
+                # a half-written field must never reach the parser
+                if not exited and k == len(folders) - 1:
+                    break
                 try:
                     s = case_fields.sample(folder, structure, geom)
                 except Exception:
