@@ -420,3 +420,36 @@ def test_bad_gap_and_layers_raise_value_error(coarse_base: BaseMesh) -> None:
                        {k: v for k, v in coarse_base.edges.items() if k != "inlet"})
     with pytest.raises(ValueError, match="exactly one patch"):
         extrude(partial, hertz_gap, N_LAYERS)
+
+
+# ---------------------------------------------------------------- grading and patch split
+def test_layer_fractions_graded_toward_both_walls():
+    from generator.mesh import layer_fractions
+
+    f = layer_fractions(8, 4.0)
+    d = np.diff(f)
+    assert f[0] == 0.0 and f[-1] == 1.0 and np.all(d > 0)
+    assert np.allclose(d, d[::-1])                        # symmetric about mid-gap
+    assert d[len(d) // 2] / d[0] == pytest.approx(4.0, rel=1e-6)
+    assert np.allclose(layer_fractions(5, 1.0), np.linspace(0, 1, 6))
+
+
+def test_split_patch_keeps_a_valid_mesh():
+    from generator.mesh import split_patch
+
+    params = MeshParams(x_min=-6 * A_HERTZ, x_max=12 * A_HERTZ, y_max=6 * A_HERTZ, island_radius=1.5 * A_HERTZ,
+                        n_layers=3)
+    mesh = extrude(build_base_mesh(params, lambda x, y: np.full_like(np.asarray(x, float), 0.5 * A_HERTZ)),
+                   hertz_gap, 3)
+    sl = mesh.patch_slice("inlet")
+    select = mesh.face_centres[sl, 1] < 2 * A_HERTZ
+    out = split_patch(mesh, "inlet", select, "supply")
+    assert out.patch("supply").size == select.sum()
+    assert out.patch("inlet").size + out.patch("supply").size == sl.stop - sl.start
+    assert out.patch("supply").start == out.patch("inlet").start + out.patch("inlet").size
+    assert np.all(out.face_centres[out.patch_slice("supply"), 1] < 2 * A_HERTZ)
+    # the same faces, reordered within the old patch only
+    assert np.array_equal(np.sort(out.owner[sl]), np.sort(mesh.owner[sl]))
+    assert np.array_equal(out.faces[:sl.start], mesh.faces[:sl.start])
+    with pytest.raises(ValueError, match="one entry per face"):
+        split_patch(mesh, "inlet", select[:-1], "supply")
