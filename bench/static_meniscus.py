@@ -51,23 +51,27 @@ def main(argv=None) -> int:
     ap.add_argument("--compression", nargs="+", type=float, default=[0.0, 1.0])
     ap.add_argument("--safety", nargs="+", type=float, default=[1.0, 0.25],
                     help="factors on the capillary time-step limit")
+    ap.add_argument("--air-viscosity", nargs="+", type=float, default=[1.8e-5],
+                    help="air viscosities [Pa s] (the reference assumes 1.8e-5)")
     ap.add_argument("--work", default=str(ROOT / "runs" / "checks" / "static_meniscus"))
     args = ap.parse_args(argv)
     rows = []
-    for level, c_alpha, safety in itertools.product(args.levels, args.compression, args.safety):
+    for level, c_alpha, safety, mu_air in itertools.product(
+            args.levels, args.compression, args.safety, args.air_viscosity):
         spec = make_case_spec({
             "name": "static", "walls_moving": False, "contact": {"speed": args.speed},
             "mesh": {"resolution": level},
             "supply": {"mode": "layers", "disc_layer": 0.0, "ball_layer": 0.0,
                        "initial_puddle": 3.0},
-            "physics": {"interface_compression": c_alpha},
+            "physics": {"interface_compression": c_alpha, "air_viscosity": mu_air},
             "run": {"end_time": args.time, "capillary_safety": safety,
                     "writes_per_transit": 200}})
-        case = Path(args.work) / f"{level}_c{c_alpha:g}_s{safety:g}"
+        case = Path(args.work) / f"{level}_c{c_alpha:g}_s{safety:g}_air{mu_air:g}"
         geom = write_case(spec, case, overwrite=True)
         m = run_case(case)
         s = spurious(case)
         row = {"level": level, "cAlpha": c_alpha, "capillary_safety": safety,
+               "air_viscosity": mu_air,
                "max_delta_t_s": geom.max_delta_t, "cells": geom.cells,
                "status": m["status"], "time_steps": m["time_steps"], "wall_s": m["wall_s"],
                "meniscus_drift_over_a": abs(m["inlet_meniscus_distance_over_a"] - 2.0)

@@ -93,7 +93,7 @@ def capillary_time_step(spec: CaseSpec, dx: float) -> float:
     p = spec.physics
     sigma = p.surface_tension
     rho = 0.5 * (spec.oil_density + p.air_density)
-    mu = 0.5 * (spec.oil_viscosity + p.air_viscosity)
+    mu = 0.5 * (spec.oil_viscosity + p.air_viscosity * spec.run.air_viscosity_factor)
     kind = spec.run.capillary_limit
     if kind == "brackbill":
         dt = math.sqrt(rho * dx**3 / (2.0 * math.pi * sigma))
@@ -228,7 +228,7 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
     with FoamFile(case / "constant" / "transportProperties") as f:
         f["oil"]["nu"] = spec.oil_viscosity / spec.oil_density
         f["oil"]["rho"] = spec.oil_density
-        f["air"]["nu"] = p.air_viscosity / p.air_density
+        f["air"]["nu"] = p.air_viscosity * spec.run.air_viscosity_factor / p.air_density
         f["air"]["rho"] = p.air_density
         f["sigma"] = p.surface_tension
     with FoamFile(case / "system" / "controlDict") as f:
