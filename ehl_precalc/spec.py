@@ -124,17 +124,21 @@ def valid_range(name: str) -> str:
     field = PrecalcSpec.model_fields.get(name)
     if field is None:
         return ""
+    text = range_text(name, field)
+    return f"{text} {UNITS.get(name, '')}".rstrip() if text else ""
+
+
+def range_text(name: str, field) -> str:
+    """'valid range 0 < name <= 1' from a pydantic field's numeric constraints ('' if none)."""
     lo = hi = ""
-    for m in field.metadata:
+    for m in getattr(field, "metadata", []):
         for attr, fmt in (("gt", "{} < "), ("ge", "{} <= ")):
             if getattr(m, attr, None) is not None:
                 lo = fmt.format(f"{getattr(m, attr):g}")
         for attr, fmt in (("lt", " < {}"), ("le", " <= {}")):
             if getattr(m, attr, None) is not None:
                 hi = fmt.format(f"{getattr(m, attr):g}")
-    if not (lo or hi):
-        return ""
-    return f"valid range {lo}{name}{hi} {UNITS.get(name, '')}".rstrip()
+    return f"valid range {lo}{name}{hi}" if lo or hi else ""
 
 
 def _format_error(err: ValidationError) -> str:

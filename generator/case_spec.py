@@ -44,7 +44,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from ehl_precalc.spec import PrecalcSpec, SpecError, read_toml
+from ehl_precalc.spec import PrecalcSpec, SpecError, range_text, read_toml
 
 _STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
@@ -278,18 +278,6 @@ def _field_at(model: type[BaseModel], loc: tuple) -> tuple[type[BaseModel] | Non
     return model, None
 
 
-def _range_text(name: str, field) -> str:
-    lo = hi = ""
-    for m in getattr(field, "metadata", []):
-        for attr, fmt in (("gt", "{} < "), ("ge", "{} <= ")):
-            if getattr(m, attr, None) is not None:
-                lo = fmt.format(f"{getattr(m, attr):g}")
-        for attr, fmt in (("lt", " < {}"), ("le", " <= {}")):
-            if getattr(m, attr, None) is not None:
-                hi = fmt.format(f"{getattr(m, attr):g}")
-    return f"valid range {lo}{name}{hi}" if lo or hi else ""
-
-
 def format_errors(err: ValidationError, root: type[BaseModel] = None) -> str:
     """One line per error: ``parameter = value: problem (valid range ...)``."""
     root = root or CaseSpec
@@ -303,7 +291,7 @@ def format_errors(err: ValidationError, root: type[BaseModel] = None) -> str:
             valid = ", ".join(model.model_fields) if model else ""
             lines.append(f"{name}: unknown parameter (valid here: {valid})")
         elif loc and "input" in e and not isinstance(e["input"], dict):
-            rng = _range_text(name, field) if field is not None else ""
+            rng = range_text(name, field) if field is not None else ""
             lines.append(f"{name} = {e['input']!r}: {msg}" + (f" ({rng})" if rng else ""))
         else:
             lines.append(f"{name}: {msg}")
