@@ -1,0 +1,70 @@
+"""Top views of the mid-gap oil fraction of finished cases, side by side (a quick look, not the
+report of issue 5): oil dark, air light, the island (unmeshed contact) black, the Hertzian
+circle red, the metrics in the titles.
+
+    python bench/plot_midgap.py OUT.png CASE [CASE ...]
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from generator.case_writer import load_geometry  # noqa: E402
+from runs import case_fields  # noqa: E402
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) < 2:
+        print(__doc__)
+        return 2
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out, cases = Path(argv[0]), [Path(c) for c in argv[1:]]
+    fig, axs = plt.subplots(len(cases), 1, figsize=(7, 3.6 * len(cases)), squeeze=False,
+                            gridspec_kw={"hspace": 0.45})
+    for ax, case in zip(axs[:, 0], cases):
+        g = load_geometry(case)
+        st = case_fields.Structure.load(case)
+        t, folder = case_fields.time_folders(case)[-1]
+        mid = np.clip(case_fields.mid_gap_alpha(folder, st, g), 0.0, 0.9999)  # inside the top level
+        x, y = st.base_x / g.a, st.base_y / g.a
+        if g.symmetric:
+            x, y, mid = np.r_[x, x], np.r_[y, -y], np.r_[mid, mid]
+        tc = ax.tricontourf(x, y, mid, levels=np.linspace(0, 1, 11), cmap="Blues")
+        ax.add_patch(plt.Circle((0, 0), g.island_radius / g.a, color="k"))
+        ax.add_patch(plt.Circle((0, 0), 1.0, color="r", fill=False, lw=1))
+        m = json.loads((case / "metrics.json").read_text()) if (case / "metrics.json").exists() else {}
+        spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
+        sup = spec["supply"]
+        supply = ("flooded" if sup["mode"] == "flooded"
+                  else f"layers {sup['disc_layer'] * 1e6:g}+{sup['ball_layer'] * 1e6:g} um")
+        fmt = lambda v: "-" if v is None else f"{v:.2f}"  # noqa: E731
+        ax.set_title(f"u = {g.speed * 1e3:g} mm/s, {supply}, {spec['mesh']['resolution']}, "
+                     f"t = {t * 1e3:.0f} ms: "
+                     f"state {m.get('state', '?')}, inlet meniscus "
+                     f"{fmt(m.get('inlet_meniscus_distance_over_a'))} a "
+                     f"({m.get('inlet_meniscus_shape') or '-'})", fontsize=8)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x / a (rolling ->)")
+        ax.set_ylabel("y / a")
+    fig.colorbar(tc, ax=axs.ravel().tolist(), label="oil fraction at mid-gap",
+                 orientation="horizontal", fraction=0.02, pad=0.04)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110, bbox_inches="tight")
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
