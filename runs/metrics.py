@@ -33,13 +33,13 @@ Inside, everything is SI; the lengths returned are ratios to ``a``.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from scipy import ndimage
-from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator
 from scipy.spatial import QhullError
 
 __all__ = [
@@ -206,6 +206,35 @@ def _grid(geom: Geometry, cell: float) -> tuple[np.ndarray, np.ndarray]:
     return xs, ys
 
 
+@functools.lru_cache(maxsize=8)
+def _resampler(points_b: bytes, n: int, xs_b: bytes, ys_b: bytes) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (k, 3) and weights (k, 3) that interpolate values at the points linearly onto
+    the grid (Delaunay triangulation; pixels outside the hull take the nearest point). Cached:
+    a case's cell centres never change, so the triangulation is built once per mesh."""
+    from scipy.spatial import Delaunay, cKDTree
+
+    points = np.frombuffer(points_b).reshape(n, 2)
+    gx, gy = np.meshgrid(np.frombuffer(xs_b), np.frombuffer(ys_b))
+    grid = np.column_stack([gx.ravel(), gy.ravel()])
+    try:
+        tri = Delaunay(points)
+    except QhullError as exc:
+        raise ValueError(f"x, y: the cell centres cannot be triangulated ({exc})") from None
+    simplex = tri.find_simplex(grid)
+    inside = simplex >= 0
+    vertices = np.zeros((len(grid), 3), dtype=np.int64)
+    weights = np.zeros((len(grid), 3))
+    T = tri.transform[simplex[inside]]
+    b = np.einsum("ijk,ik->ij", T[:, :2], grid[inside] - T[:, 2])
+    vertices[inside] = tri.simplices[simplex[inside]]
+    weights[inside] = np.column_stack([b, 1.0 - b.sum(axis=1)])
+    if (~inside).any():
+        _, nearest = cKDTree(points).query(grid[~inside])
+        vertices[~inside, 0] = nearest
+        weights[~inside, 0] = 1.0
+    return vertices, weights
+
+
 def raster(x: Any, y: Any, alpha: Any, geom: Geometry, cell: float | None = None) -> Raster:
     """Resample ``alpha`` at cell centres ``(x, y)`` onto a regular full-domain grid.
 
@@ -230,13 +259,8 @@ def raster(x: Any, y: Any, alpha: Any, geom: Geometry, cell: float | None = None
     xs, ys = _grid(geom, float(cell))
     gx, gy = np.meshgrid(xs, ys)
     points = np.column_stack([x, y])
-    try:
-        values = LinearNDInterpolator(points, alpha)(gx, gy)
-    except QhullError as exc:
-        raise ValueError(f"x, y: the cell centres cannot be triangulated ({exc})") from None
-    outside = np.isnan(values)
-    if outside.any():
-        values[outside] = NearestNDInterpolator(points, alpha)(gx[outside], gy[outside])
+    vertices, weights = _resampler(points.tobytes(), len(points), xs.tobytes(), ys.tobytes())
+    values = np.einsum("ij,ij->i", alpha[vertices], weights).reshape(gx.shape)
     island = gx**2 + gy**2 <= geom.island_radius**2
     values = np.clip(values, 0.0, 1.0)
     values[island] = np.nan
