@@ -72,6 +72,7 @@ def main(argv=None) -> int:
         s = spurious(case)
         row = {"level": level, "cAlpha": c_alpha, "capillary_safety": safety,
                "air_viscosity": mu_air,
+               "air_viscosity_in_solver": mu_air * spec.run.air_viscosity_factor,
                "max_delta_t_s": geom.max_delta_t, "cells": geom.cells,
                "status": m["status"], "time_steps": m["time_steps"], "wall_s": m["wall_s"],
                "meniscus_drift_over_a": abs(m["inlet_meniscus_distance_over_a"] - 2.0)
