@@ -89,7 +89,7 @@ class Physics(BaseModel):
         viscosity_factor: multiplies the oil viscosity (and divides nothing else); 3 turns
             a one-cell-thick gap into Reynolds flow (used by the single-phase check only).
         interface_compression: interFoam's cAlpha (1, the default, keeps the meniscus sharp;
-            0 gives 7x smaller spurious air currents and 3x cheaper runs but smears the
+            0 gives 3-15x smaller spurious currents in the oil but smears the
             interface over a few transits: docs/cases.md).
     """
 
