@@ -83,9 +83,24 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     from runs.run_case import CaseBusy, run_case
 
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    progress = Progress(TextColumn("{task.description}"), BarColumn(),
+                        TextColumn("{task.fields[status]}"), TimeElapsedColumn(),
+                        disable=args.quiet or not sys.stdout.isatty())
+    task = progress.add_task(f"interFoam {args.case}", total=1.0, status="starting")
+
+    def on_sample(sample, geom) -> None:
+        p = sample.pattern
+        progress.update(task, completed=sample.time / geom.end_time,
+                        status=f"t = {sample.time * 1e3:.1f} ms, state {p.get('state')}, "
+                               f"oil {sample.oil_volume * 1e12:.2f} nl")
+        if not args.quiet:
+            progress.console.print(_sample_line(sample, geom), highlight=False, soft_wrap=True)
+
     try:
-        metrics = run_case(args.case, wall_limit=args.wall_limit,
-                           on_sample=None if args.quiet else _print_sample)
+        with progress:
+            metrics = run_case(args.case, wall_limit=args.wall_limit, on_sample=on_sample)
     except (CaseBusy, FileNotFoundError) as err:
         print(f"ehlfoam run: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -97,14 +112,15 @@ def cmd_run(args: argparse.Namespace) -> int:
     return EXIT_OK if metrics["status"] == "finished" else EXIT_FAILURE
 
 
-def _print_sample(sample, geom) -> None:
+def _sample_line(sample, geom) -> str:
+    """One line per written time: time, transits, state, oil volume, menisci."""
     p = sample.pattern
     fmt = lambda v: "-" if v is None else f"{v:.2f}"  # noqa: E731
-    print(f"t = {sample.time * 1e3:8.2f} ms ({sample.time / geom.transit_time:5.2f} transits)  "
-          f"state {p.get('state')}  oil {sample.oil_volume * 1e12:9.4f} nl  "
-          f"inlet meniscus {fmt(p.get('inlet_meniscus_distance_over_a'))} a  "
-          f"flooded {fmt(p.get('flooded_length_over_a'))} x {fmt(p.get('flooded_width_over_a'))} a",
-          flush=True)
+    return (f"t = {sample.time * 1e3:8.2f} ms ({sample.time / geom.transit_time:5.2f} transits)  "
+            f"state {p.get('state')}  oil {sample.oil_volume * 1e12:9.4f} nl  "
+            f"inlet meniscus {fmt(p.get('inlet_meniscus_distance_over_a'))} a  "
+            f"flooded {fmt(p.get('flooded_length_over_a'))} x "
+            f"{fmt(p.get('flooded_width_over_a'))} a")
 
 
 def build_parser() -> argparse.ArgumentParser:
