@@ -284,3 +284,20 @@ def test_monitor_stops_a_steady_run(tmp_path):
     assert m["status"] == "finished" and m["end_reason"] == "steady" and m["steady"], m
     assert m["simulated_time_s"] < 0.5 * spec.end_time
     assert FoamFile(case / "system" / "controlDict")["stopAt"] == "writeNow"
+
+
+def test_cli_run_prints_metrics_and_exit_code(small_case, tmp_path):
+    case = _copy(small_case, tmp_path)
+    with FoamFile(case / "system" / "controlDict") as f:
+        f["endTime"] = 2e-4
+        f["writeInterval"] = 1e-4
+    proc = subprocess.run([*EHLFOAM, "run", str(case)], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.strip().splitlines()
+    assert any(ln.startswith("t =") and "state" in ln for ln in lines)   # progress lines
+    result = json.loads(lines[-1])
+    assert result["status"] == "finished" and result["end_reason"] == "end_time"
+    busy = subprocess.run([*EHLFOAM, "run", str(tmp_path / "nowhere")], capture_output=True,
+                          text=True)
+    assert busy.returncode == 2 and "nowhere" in busy.stderr
