@@ -59,7 +59,8 @@ def main(argv=None) -> int:
         ax.set_xlabel("x / a (rolling ->)")
         ax.set_ylabel("y / a")
     fig.colorbar(tc, ax=axs.ravel().tolist(), label="oil fraction at mid-gap",
-                 orientation="horizontal", fraction=0.02, pad=0.04)
+                 orientation="horizontal", fraction=0.02 if len(cases) > 1 else 0.05,
+                 pad=0.04 if len(cases) > 1 else 0.2)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110, bbox_inches="tight")
     print(f"wrote {out}")
