@@ -234,6 +234,11 @@ class CaseSpec(BaseModel):
         return self.contact.speed
 
     @property
+    def wall_speed(self) -> float:
+        """Speed of the disc and the ball surface [m/s]: u, or 0 with walls_moving false."""
+        return self.speed if self.walls_moving else 0.0
+
+    @property
     def oil_viscosity(self) -> float:
         """Oil dynamic viscosity at ambient pressure [Pa s], times viscosity_factor."""
         return self.contact.oil().eta0 * self.physics.viscosity_factor

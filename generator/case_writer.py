@@ -110,7 +110,7 @@ def _overlap(lo, hi, a, b):
     return np.clip(np.minimum(hi, b) - np.maximum(lo, a), 0.0, None)
 
 
-def oil_fraction(spec: CaseSpec, y, z_lo, z_hi, gap_h, on_track) -> np.ndarray:
+def oil_fraction(spec: CaseSpec, z_lo, z_hi, gap_h, on_track) -> np.ndarray:
     """Oil fraction of cells or faces spanning z in [z_lo, z_hi] of a column of gap gap_h [m]:
     the supply layers on the disc and the ball ("layers") or the whole height ("flooded"),
     times ``on_track`` (bool, or the fraction of the face on the track)."""
@@ -136,7 +136,7 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     h = gap(x, y)
     k = mesh.layer
     on_track = np.abs(y) < spec.supply.track_half_width
-    alpha = oil_fraction(spec, y, h * f[k], h * f[k + 1], h, on_track)
+    alpha = oil_fraction(spec, h * f[k], h * f[k + 1], h, on_track)
     puddle = np.hypot(x, y) < spec.supply.initial_puddle * spec.a
     return np.where(puddle, 1.0, alpha)
 
@@ -161,27 +161,30 @@ def supply_fraction(spec: CaseSpec, mesh: PolyMesh, patch: str = "inlet") -> np.
     w = spec.supply.track_half_width
     y_lo, y_hi = mesh.points[faces, 1].min(axis=1), mesh.points[faces, 1].max(axis=1)
     on_track = _overlap(y_lo, y_hi, -w, w) / np.maximum(y_hi - y_lo, 1e-300)
-    return oil_fraction(spec, y, z_lo, z_hi, column[inverse], on_track)
+    return oil_fraction(spec, z_lo, z_hi, column[inverse], on_track)
 
 
-def with_supply_patch(spec: CaseSpec, mesh: PolyMesh) -> PolyMesh:
+def with_supply_patch(spec: CaseSpec, mesh: PolyMesh) -> tuple[PolyMesh, np.ndarray]:
     """Split the inlet: faces that carry oil in become the ``supply`` patch (fixed inflow at
-    the rolling speed), the rest stays an open boundary at ambient pressure."""
+    the rolling speed), the rest stays an open boundary at ambient pressure. Returns the mesh
+    and the oil fraction of each supply face, in the supply patch's face order."""
     frac = supply_fraction(spec, mesh)
-    return split_patch(mesh, "inlet", frac > 1e-6, "supply")
+    carries = frac > 1e-6
+    return split_patch(mesh, "inlet", carries, "supply"), frac[carries]
 
 
 def island_velocity(spec: CaseSpec, mesh: PolyMesh) -> np.ndarray:
     """Velocity of the island faces: (u, 0, 0) projected on the wall (no through-flow)."""
     sl = mesh.patch_slice("island")
     n = mesh.face_areas[sl] / np.linalg.norm(mesh.face_areas[sl], axis=1, keepdims=True)
-    u = np.array([spec.speed if spec.walls_moving else 0.0, 0.0, 0.0])
+    u = np.array([spec.wall_speed, 0.0, 0.0])
     return u - n * (n @ u)[:, None]
 
 
 # ----------------------------------------------------------------- writing
-def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, gap, geom: CaseGeometry) -> None:
-    u = spec.speed if spec.walls_moving else 0.0
+def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, supply: np.ndarray, gap,
+                 geom: CaseGeometry) -> None:
+    u = spec.wall_speed
     with FoamFieldFile(case / "0.orig" / "U") as f:
         f.boundary_field["disc"]["value"] = np.array([u, 0.0, 0.0])
         f.boundary_field["ball"]["origin"] = np.array([0.0, 0.0, spec.contact.radius])
@@ -193,16 +196,14 @@ def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, gap, geom: CaseGeom
     with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
         f.internal_field = initial_alpha(spec, mesh, gap)
         f.boundary_field['"(disc|ball|island)"']["theta0"] = spec.physics.contact_angle
-        supply = None
-        if any(p.name == "supply" for p in mesh.patches):
-            supply = supply_fraction(spec, mesh, "supply")
+        if len(supply):
             f.boundary_field["supply"]["value"] = (supply if len(supply) not in (3, 6, 9)
                                                    else _PLACEHOLDER)
         if spec.scene == "single-phase":
             f.boundary_field['"(inlet|outlet|side)"']["inletValue"] = 1.0
         if not geom.symmetric:
             del f.boundary_field["symmetry"]
-    if supply is not None and len(supply) in (3, 6, 9):
+    if len(supply) in (3, 6, 9):
         _write_scalar_list(case / "0.orig" / "alpha.oil", supply)
     if not geom.symmetric:
         with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
@@ -277,9 +278,10 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
                         symmetric=d.symmetry == "half")
     mesh = extrude(build_base_mesh(params, size_function(spec)), gap, level["n_layers"],
                    level["wall_grading"])
-    mesh = with_supply_patch(spec, mesh)
+    mesh, supply = with_supply_patch(spec, mesh)
     dx = level["size_rim"] * a
     dt = capillary_time_step(spec, dx)
+    write_interval = _write_interval(spec)
     summary = _read_json(precalc / "summary.json")
     hc = float(summary["hc_m"])
     geom = CaseGeometry(
@@ -287,8 +289,8 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         x_max=params.x_max, y_max=params.y_max, island_radius=params.island_radius,
         symmetric=params.symmetric, n_layers=params.n_layers, cells=len(mesh.cell_volumes),
         transit_time=spec.transit_time, end_time=spec.end_time,
-        write_interval=_write_interval(spec),
-        max_delta_t=min(dt, _write_interval(spec)),
+        write_interval=write_interval,
+        max_delta_t=min(dt, write_interval),
         capillary_limit=spec.run.capillary_limit, min_cell_size=dx,
         island_gap=float(gap(np.array([params.island_radius]), np.array([0.0]))[0]),
         hc=hc, contact_flow=spec.speed * hc * 2.0 * a,
@@ -300,7 +302,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
     try:
         shutil.copytree(TEMPLATES / _template_for(spec), tmp, dirs_exist_ok=True)
         write_polymesh(mesh, tmp)
-        _edit_fields(spec, tmp, mesh, gap, geom)
+        _edit_fields(spec, tmp, mesh, supply, gap, geom)
         _edit_dicts(spec, tmp, geom)
         _write_scripts(tmp, runtime, spec.run.n_procs)
         meta = tmp / META

@@ -102,10 +102,26 @@ def pattern_geometry(geom: CaseGeometry) -> metrics.Geometry:
                             x_max=geom.x_max, y_max=geom.y_max, symmetric=geom.symmetric)
 
 
+def _read_alpha(path: Path, structure: Structure) -> tuple[np.ndarray, FoamFieldFile]:
+    """The oil fraction per cell of the alpha.oil file ``path`` (and the file, for its
+    boundary values)."""
+    n = len(structure.cell_volumes)
+    file = FoamFieldFile(path)
+    alpha = _uniform_or_list(file.internal_field, n)
+    if alpha.shape != (n,):
+        raise ValueError(f"{path} has {alpha.shape} values, expected {n}")
+    return alpha, file
+
+
+def _oil_volume(alpha: np.ndarray, structure: Structure, geom: CaseGeometry) -> float:
+    """Oil volume [m3] of the whole contact (doubled in a half domain)."""
+    mirror = 2.0 if geom.symmetric else 1.0
+    return mirror * float(np.sum(np.clip(alpha, 0.0, 1.0) * structure.cell_volumes))
+
+
 def mid_gap_alpha(folder: Path, structure: Structure, geom: CaseGeometry) -> np.ndarray:
-    alpha = _uniform_or_list(FoamFieldFile(folder / "alpha.oil").internal_field,
-                             len(structure.cell_volumes))
-    return structure.mid_gap(alpha, geom.n_layers)
+    """The oil fraction at mid-gap of the time folder ``folder``, per base cell."""
+    return structure.mid_gap(_read_alpha(folder / "alpha.oil", structure)[0], geom.n_layers)
 
 
 def _complete(path: Path) -> Path:
@@ -125,13 +141,9 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     for name in ("alpha.oil", "phi", "alphaPhi0.oil"):
         if (folder / name).exists() or name == "alpha.oil":
             _complete(folder / name)
-    n = len(structure.cell_volumes)
-    alpha_file = FoamFieldFile(folder / "alpha.oil")
-    alpha = _uniform_or_list(alpha_file.internal_field, n)
-    if alpha.shape != (n,):
-        raise ValueError(f"{folder}/alpha.oil has {alpha.shape} values, expected {n}")
+    alpha, alpha_file = _read_alpha(folder / "alpha.oil", structure)
+    volume = _oil_volume(alpha, structure, geom)
     mirror = 2.0 if geom.symmetric else 1.0
-    volume = mirror * float(np.sum(np.clip(alpha, 0.0, 1.0) * structure.cell_volumes))
     # the oil flux MULES transported (alphaPhi0.oil); phi * face alpha where it is absent
     oil_flux_file = folder / "alphaPhi0.oil"
     flux_bf = FoamFieldFile(oil_flux_file if oil_flux_file.exists() else folder / "phi").boundary_field
@@ -155,7 +167,4 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
 
 def initial_oil_volume(case: Path, structure: Structure, geom: CaseGeometry) -> float:
     """Oil volume at t = 0 [m3, whole contact] from 0.orig."""
-    alpha = _uniform_or_list(FoamFieldFile(case / "0.orig" / "alpha.oil").internal_field,
-                             len(structure.cell_volumes))
-    mirror = 2.0 if geom.symmetric else 1.0
-    return mirror * float(np.sum(np.clip(alpha, 0.0, 1.0) * structure.cell_volumes))
+    return _oil_volume(_read_alpha(case / "0.orig" / "alpha.oil", structure)[0], structure, geom)

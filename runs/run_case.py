@@ -88,7 +88,6 @@ class LogTail:
     def __init__(self, path: Path):
         self.path, self.offset, self.steps, self.small_steps = path, 0, 0, 0
         self.last_dt = math.nan
-        self.last_time = 0.0
 
     def update(self, dt_floor: float) -> None:
         try:
@@ -103,10 +102,7 @@ class LogTail:
         for m in _STEP.finditer(text):
             self.last_dt = float(m.group(1))
             self.small_steps = self.small_steps + 1 if self.last_dt < dt_floor else 0
-        times = _TIME.findall(text)
-        self.steps += len(times)
-        if times:
-            self.last_time = float(times[-1])
+        self.steps += len(_TIME.findall(text))
 
 
 def _write_history(case: Path, history: list[case_fields.Sample]) -> None:
@@ -194,25 +190,7 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
             tail.update(dt_floor)
             if n_procs > 1:
                 _reconstruct_new(case, runtime)
-            folders = case_fields.time_folders(case)
-            for k, (_, folder) in enumerate(folders):
-                if folder.name in done:
-                    continue
-                # a folder is read once the solver has moved on to the next one (or ended):
-                # a half-written field must never reach the parser
-                if not exited and k == len(folders) - 1:
-                    break
-                try:
-                    s = case_fields.sample(folder, structure, geom)
-                except Exception:
-                    if exited:
-                        done.add(folder.name)
-                    continue   # still being written: next poll
-                done.add(folder.name)
-                history.append(s)
-                _write_history(case, history)
-                if on_sample:
-                    on_sample(s, geom)
+            _collect(case, structure, geom, history, done, exited, on_sample)
             if exited:
                 break
             if reason is None:
@@ -244,14 +222,7 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
         proc.wait()
     if n_procs > 1:   # the last writes, then one more sample pass
         _reconstruct_new(case, runtime)
-        for _, folder in case_fields.time_folders(case):
-            if folder.name not in done:
-                try:
-                    history.append(case_fields.sample(folder, structure, geom))
-                except Exception:
-                    pass
-                done.add(folder.name)
-        _write_history(case, history)
+        _collect(case, structure, geom, history, done, True, on_sample)
     wall = time.monotonic() - t_start
     rc = proc.returncode
     if reason is None:
@@ -260,6 +231,36 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
     metrics = _final_metrics(spec, geom, v0, history, reason, failed, rc, tail, wall, case)
     atomic_write_json(case / "metrics.json", metrics)
     return metrics
+
+
+def _collect(case: Path, structure, geom: CaseGeometry, history: list[case_fields.Sample],
+             done: set[str], exited: bool, on_sample) -> None:
+    """Sample the time folders not read yet into ``history`` and rewrite history.csv.
+
+    While the solver runs, a folder is read only once the solver has moved on to the next one
+    (a half-written field must never reach the parser) and a failed read is retried at the
+    next poll; once it has exited, every folder is read once and unreadable ones are skipped.
+    """
+    folders = case_fields.time_folders(case)
+    new = False
+    for k, (_, folder) in enumerate(folders):
+        if folder.name in done:
+            continue
+        if not exited and k == len(folders) - 1:
+            break
+        try:
+            s = case_fields.sample(folder, structure, geom)
+        except Exception:
+            if exited:
+                done.add(folder.name)
+            continue   # still being written: next poll
+        done.add(folder.name)
+        history.append(s)
+        new = True
+        if on_sample:
+            on_sample(s, geom)
+    if new:
+        _write_history(case, history)
 
 
 def _reconstruct_new(case: Path, runtime: FoamRuntime) -> None:
