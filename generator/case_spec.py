@@ -68,6 +68,10 @@ class Supply(BaseModel):
         track_half_width: half-width of the oil track at the inlet [m].
         initial_puddle: radius of the oil puddle around the contact at t = 0, units of a
             (0: none).
+        initial_bubble: radius of a gas seed at t = 0, units of a, centred on the
+            downstream point of the island rim (0: none). Neither scene nucleates gas: with
+            ample oil the cavitating scene has a bubble only if one is seeded (or air is
+            carried in between thin layers); docs/cavitation.md.
     """
 
     model_config = _STRICT
@@ -76,6 +80,7 @@ class Supply(BaseModel):
     ball_layer: float = Field(2e-6, ge=0.0, le=1e-3)
     track_half_width: float = Field(3e-4, gt=0.0, le=0.1)
     initial_puddle: float = Field(4.0, ge=0.0, le=100.0)
+    initial_bubble: float = Field(0.0, ge=0.0, le=20.0)
 
 
 class Physics(BaseModel):
@@ -91,6 +96,13 @@ class Physics(BaseModel):
         interface_compression: interFoam's cAlpha (1, the default, keeps the meniscus sharp;
             0 gives 3-15x smaller spurious currents in the oil but smears the
             interface over a few transits: docs/cases.md).
+        ambient_pressure: [Pa, absolute] at the open boundaries (cavitating scene; the
+            interface scene works in gauge pressure and adds it only to report one).
+        cavitation_pressure: [Pa, absolute] the pressure floor of the cavitating scene
+            (compressibleInterFoam's pMin). The reference assumes 0; a perfect gas needs a
+            positive floor, so the default is 1 kPa (sensitivity in docs/cavitation.md).
+        oil_bulk_modulus: [Pa] of the oil in the cavitating scene (assumed 1.5 GPa, a
+            mineral oil's isothermal value at ambient pressure).
     """
 
     model_config = _STRICT
@@ -101,6 +113,9 @@ class Physics(BaseModel):
     air_viscosity: float = Field(1.8e-5, gt=0.0, le=1.0)
     viscosity_factor: float = Field(1.0, gt=0.0, le=1e3)
     interface_compression: float = Field(1.0, ge=0.0, le=4.0)
+    ambient_pressure: float = Field(1.013e5, gt=1e3, le=1e7)
+    cavitation_pressure: float = Field(1e3, gt=0.0, le=1e5)
+    oil_bulk_modulus: float = Field(1.5e9, gt=1e6, le=1e11)
 
 
 class Domain(BaseModel):
@@ -200,20 +215,27 @@ class Run(BaseModel):
     n_procs: int = Field(1, ge=1, le=1024)
 
 
+#: The OpenFOAM application of each scene.
+SOLVERS = {"interface": "interFoam", "single-phase": "interFoam",
+           "cavitating": "compressibleInterFoam"}
+
+
 class CaseSpec(BaseModel):
     """One OpenFOAM case around the EHL contact.
 
     Attributes:
         name: label used in reports.
         scene: "interface": two-phase oil/air, surface tension, no cavitation (interFoam);
-            "single-phase": oil everywhere (the check against the Reynolds solution).
+            "single-phase": oil everywhere (the check against the Reynolds solution);
+            "cavitating": two-phase oil/air where the air is a perfect gas that expands
+            below ambient pressure, down to the cavitation pressure (compressibleInterFoam).
         contact: the EHL conditions (:class:`ehl_precalc.spec.PrecalcSpec`).
         walls_moving: False holds both walls still (the static-meniscus test).
     """
 
     model_config = _STRICT
     name: str = "case"
-    scene: Literal["interface", "single-phase"] = "interface"
+    scene: Literal["interface", "single-phase", "cavitating"] = "interface"
     contact: PrecalcSpec = PrecalcSpec(speed=0.008)
     supply: Supply = Supply()
     physics: Physics = Physics()
@@ -247,6 +269,16 @@ class CaseSpec(BaseModel):
     def oil_density(self) -> float:
         """[kg/m3]."""
         return self.physics.oil_density or self.contact.oil().rho0
+
+    @property
+    def solver(self) -> str:
+        """The OpenFOAM application of the scene."""
+        return SOLVERS[self.scene]
+
+    @property
+    def temperature_k(self) -> float:
+        """Oil (and air) temperature [K]."""
+        return self.contact.temperature + 273.15
 
     @property
     def transit_time(self) -> float:

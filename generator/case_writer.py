@@ -66,6 +66,18 @@ class CaseGeometry:
     gap_mismatch: float
     oil_viscosity: float
     oil_density: float
+    solver: str = "interFoam"
+    ambient_pressure: float = 1.013e5
+
+    @property
+    def absolute_pressure(self) -> bool:
+        """The solver's p is absolute (compressible scenes), else gauge (0 = ambient)."""
+        return self.solver.startswith("compressible")
+
+    @property
+    def log_name(self) -> str:
+        """The solver's log file in the case folder."""
+        return f"log.{self.solver}"
 
 
 # --------------------------------------------------------------- numbers
@@ -126,8 +138,9 @@ def oil_fraction(spec: CaseSpec, z_lo, z_hi, gap_h, on_track) -> np.ndarray:
 
 
 def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
-    """alpha.oil at t = 0: the supply layers on the track and a puddle of radius
-    initial_puddle a around the contact (whole gap height); all oil for single-phase."""
+    """alpha.oil at t = 0: the supply layers on the track, a puddle of radius
+    initial_puddle a around the contact (whole gap height) and a gas seed of radius
+    initial_bubble a on the island's downstream rim; all oil for single-phase."""
     if spec.scene == "single-phase":
         return np.ones(len(mesh.cell_volumes))
     x, y = mesh.cell_centres[:, 0], mesh.cell_centres[:, 1]
@@ -138,7 +151,10 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     on_track = np.abs(y) < spec.supply.track_half_width
     alpha = oil_fraction(spec, h * f[k], h * f[k + 1], h, on_track)
     puddle = np.hypot(x, y) < spec.supply.initial_puddle * spec.a
-    return np.where(puddle, 1.0, alpha)
+    alpha = np.where(puddle, 1.0, alpha)
+    rim = spec.domain.island_radius * spec.a
+    seed = np.hypot(x - rim, y) < spec.supply.initial_bubble * spec.a
+    return np.where(seed, 0.0, alpha)
 
 
 def supply_fraction(spec: CaseSpec, mesh: PolyMesh, patch: str = "inlet") -> np.ndarray:
@@ -208,6 +224,27 @@ def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, supply: np.ndarray,
     if not geom.symmetric:
         with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
             del f.boundary_field["symmetry"]
+    if spec.scene == "cavitating":
+        _edit_thermo_fields(spec, case, geom)
+
+
+def _edit_thermo_fields(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
+    """The cavitating scene's absolute pressure (ambient at the open boundaries) and T."""
+    p_amb, temp = spec.physics.ambient_pressure, spec.temperature_k
+    with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
+        f.internal_field = p_amb
+        f.boundary_field['"(inlet|outlet|side)"']["p0"] = p_amb
+    with FoamFieldFile(case / "0.orig" / "p") as f:
+        f.internal_field = p_amb
+        if not geom.symmetric:
+            del f.boundary_field["symmetry"]
+    with FoamFieldFile(case / "0.orig" / "T") as f:
+        f.internal_field = temp
+        f.boundary_field["supply"]["value"] = temp
+        f.boundary_field['"(inlet|outlet|side)"']["inletValue"] = temp
+        f.boundary_field['"(inlet|outlet|side)"']["value"] = temp
+        if not geom.symmetric:
+            del f.boundary_field["symmetry"]
 
 
 #: foamlib (1.7) writes a scalar list of 3, 6 or 9 values as a uniform vector or tensor; such
@@ -225,13 +262,10 @@ def _write_scalar_list(path: Path, values: np.ndarray) -> None:
 
 
 def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
-    p = spec.physics
-    with FoamFile(case / "constant" / "transportProperties") as f:
-        f["oil"]["nu"] = spec.oil_viscosity / spec.oil_density
-        f["oil"]["rho"] = spec.oil_density
-        f["air"]["nu"] = p.air_viscosity * spec.run.air_viscosity_factor / p.air_density
-        f["air"]["rho"] = p.air_density
-        f["sigma"] = p.surface_tension
+    if spec.scene == "cavitating":
+        _edit_thermo(spec, case)
+    else:
+        _edit_transport(spec, case)
     with FoamFile(case / "system" / "controlDict") as f:
         f["endTime"] = geom.end_time
         f["writeInterval"] = geom.write_interval
@@ -245,7 +279,35 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
         f["coeffs"]["n"] = [spec.run.n_procs, 1, 1]
 
 
-def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int) -> None:
+def _edit_transport(spec: CaseSpec, case: Path) -> None:
+    """interFoam's two incompressible phases and the surface tension."""
+    p = spec.physics
+    with FoamFile(case / "constant" / "transportProperties") as f:
+        f["oil"]["nu"] = spec.oil_viscosity / spec.oil_density
+        f["oil"]["rho"] = spec.oil_density
+        f["air"]["nu"] = p.air_viscosity * spec.run.air_viscosity_factor / p.air_density
+        f["air"]["rho"] = p.air_density
+        f["sigma"] = p.surface_tension
+
+
+def _edit_thermo(spec: CaseSpec, case: Path) -> None:
+    """compressibleInterFoam's phases: the oil a perfect fluid of the given bulk modulus
+    (rho = rho0 + p/(R T), R = K/(rho0 T)), the air a perfect gas; surface tension and the
+    pressure floor (the cavitation pressure)."""
+    p, const = spec.physics, case / "constant"
+    with FoamFile(const / "thermophysicalProperties") as f:
+        f["sigma"] = p.surface_tension
+        f["pMin"] = p.cavitation_pressure
+    with FoamFile(const / "thermophysicalProperties.oil") as f:
+        f["mixture"]["equationOfState"]["rho0"] = spec.oil_density
+        f["mixture"]["equationOfState"]["R"] = (p.oil_bulk_modulus
+                                                / (spec.oil_density * spec.temperature_k))
+        f["mixture"]["transport"]["mu"] = spec.oil_viscosity
+    with FoamFile(const / "thermophysicalProperties.air") as f:
+        f["mixture"]["transport"]["mu"] = p.air_viscosity * spec.run.air_viscosity_factor
+
+
+def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int, solver: str) -> None:
     """Fill the runtime into the hand-runnable Allrun (launch words, application folder)."""
     argv = runtime.command("APP")
     app_path = Path(argv[-1])
@@ -253,7 +315,8 @@ def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int) -> None:
               "@FOAM_BIN@": str(app_path.parent) if app_path.is_absolute() else "",
               "@WM_PROJECT_DIR@": runtime.env({}).get("WM_PROJECT_DIR", ""),
               "@NPROCS@": str(n_procs),
-              "@PARALLEL_INTERFOAM@": shlex.join(runtime.mpi_command("interFoam", n_procs, "."))
+              "@SOLVER@": solver,
+              "@PARALLEL_SOLVER@": shlex.join(runtime.mpi_command(solver, n_procs, "."))
               if n_procs > 1 else "false"}  # the serial branch runs instead
     text = (case / "Allrun").read_text()
     for key, value in values.items():
@@ -295,7 +358,8 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         island_gap=float(gap(np.array([params.island_radius]), np.array([0.0]))[0]),
         hc=hc, contact_flow=spec.speed * hc * 2.0 * a,
         gap_mismatch=gap_mismatch(mesh, gap),
-        oil_viscosity=spec.oil_viscosity, oil_density=spec.oil_density)
+        oil_viscosity=spec.oil_viscosity, oil_density=spec.oil_density,
+        solver=spec.solver, ambient_pressure=spec.physics.ambient_pressure)
 
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))
@@ -304,7 +368,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         write_polymesh(mesh, tmp)
         _edit_fields(spec, tmp, mesh, supply, gap, geom)
         _edit_dicts(spec, tmp, geom)
-        _write_scripts(tmp, runtime, spec.run.n_procs)
+        _write_scripts(tmp, runtime, spec.run.n_procs, spec.solver)
         meta = tmp / META
         meta.mkdir()
         atomic_write_text(meta / "spec.json", spec.model_dump_json(indent=2) + "\n")
@@ -327,7 +391,8 @@ def _write_interval(spec: CaseSpec) -> float:
 
 
 def _template_for(spec: CaseSpec) -> str:
-    return {"interface": "interface", "single-phase": "interface"}[spec.scene]
+    return {"interface": "interface", "single-phase": "interface",
+            "cavitating": "cavitating"}[spec.scene]
 
 
 def _read_json(path: Path) -> dict:

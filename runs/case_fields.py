@@ -91,7 +91,8 @@ class Sample:
 
     def row(self) -> dict:
         keys = ("state", "inlet_meniscus_distance_over_a", "flooded_length_over_a",
-                "flooded_width_over_a", "wake_gas_length_over_a", "enclosed_bubbles")
+                "flooded_width_over_a", "wake_gas_length_over_a", "enclosed_bubbles",
+                "bubble_length_over_a", "bubble_volume_m3", "min_pressure_Pa")
         return {"time_s": self.time, "oil_volume_m3": self.oil_volume,
                 "oil_in_m3_s": self.oil_in, "oil_out_m3_s": self.oil_out,
                 **{k: self.pattern.get(k) for k in keys}}
@@ -159,10 +160,37 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
         q_in += mirror * float(-flux[flux < 0].sum())
         q_out += mirror * float(flux[flux > 0].sum())
     mid = structure.mid_gap(alpha, geom.n_layers)
-    pattern = metrics.flow_pattern(structure.base_x, structure.base_y, mid,
-                                   pattern_geometry(geom))
+    r = metrics.raster(structure.base_x, structure.base_y, mid, pattern_geometry(geom))
+    pattern = metrics.flow_pattern_from_raster(r)
+    pattern["bubble_volume_m3"] = _bubble_volume(r, alpha, structure, geom)
+    pattern["min_pressure_Pa"] = _min_pressure(folder, structure, geom)
     return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
                   pattern=pattern)
+
+
+def _bubble_volume(r: metrics.Raster, alpha: np.ndarray, structure: Structure,
+                   geom: CaseGeometry) -> float:
+    """Gas volume [m3, whole contact] in the gap columns under the bubble's footprint."""
+    mask = metrics.bubble_mask(r)
+    if not mask.any():
+        return 0.0
+    ix = np.clip(np.rint((structure.base_x - r.x[0]) / r.dx).astype(int), 0, len(r.x) - 1)
+    iy = np.clip(np.rint((structure.base_y - r.y[0]) / r.dy).astype(int), 0, len(r.y) - 1)
+    under = mask[iy, ix][structure.base_cell]
+    mirror = 2.0 if geom.symmetric else 1.0
+    gas = 1.0 - np.clip(alpha, 0.0, 1.0)
+    return mirror * float(np.sum(gas[under] * structure.cell_volumes[under]))
+
+
+def _min_pressure(folder: Path, structure: Structure, geom: CaseGeometry) -> float | None:
+    """Lowest absolute pressure [Pa] in the cells: the cavitating scene's p is absolute, the
+    interface scene's is gauge (ambient added). None when p was not written."""
+    path = folder / "p"
+    if not path.exists():
+        return None
+    p = _uniform_or_list(FoamFieldFile(_complete(path)).internal_field, len(structure.cell_volumes))
+    offset = 0.0 if geom.absolute_pressure else geom.ambient_pressure
+    return float(p.min() + offset)
 
 
 def initial_oil_volume(case: Path, structure: Structure, geom: CaseGeometry) -> float:

@@ -47,6 +47,7 @@ __all__ = [
     "Raster",
     "flow_pattern",
     "flow_pattern_from_raster",
+    "bubble_mask",
     "meniscus_contours",
     "raster",
 ]
@@ -395,6 +396,31 @@ def _wake_gas_end(r: Raster, gas: np.ndarray, oil: np.ndarray, threshold: float)
     return _crossing(r.x[k - 1], alpha[k - 1], r.x[k], alpha[k], threshold)
 
 
+def bubble_mask(r: Raster, threshold: float = 0.5) -> np.ndarray:
+    """The cavitation bubble: gas pixels (4-connected regions) that touch the island rim
+    downstream of the contact (rim pixels at x > 0). Empty when oil follows the rim."""
+    gas = r.gas(threshold)
+    rim = _rim_mask(r.island) & (np.broadcast_to(r.x, r.island.shape) > 0.0)
+    labels, _ = ndimage.label(gas, structure=_FOUR)
+    hit = np.unique(labels[rim & gas])
+    return np.isin(labels, hit[hit > 0])
+
+
+def _bubble(r: Raster, outer: np.ndarray, threshold: float) -> dict[str, Any]:
+    """Bubble metrics (see :func:`flow_pattern`)."""
+    a = r.geom.a
+    bubble = bubble_mask(r, threshold)
+    if not bubble.any():
+        return {"bubble_length_over_a": 0.0, "bubble_width_over_a": 0.0,
+                "bubble_enclosed": False}
+    alpha, oil = np.nan_to_num(r.alpha, nan=1.0), r.oil(threshold)
+    _, tip = _extent(bubble, alpha, oil, r.x, threshold)
+    y_lo, y_hi = _extent(bubble.T, alpha.T, oil.T, r.y, threshold)
+    return {"bubble_length_over_a": max(0.0, float((tip - a) / a)),
+            "bubble_width_over_a": float((y_hi - y_lo) / a),
+            "bubble_enclosed": not bool((bubble & outer).any())}
+
+
 # --------------------------------------------------------------------------
 # public API
 
@@ -444,6 +470,7 @@ def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any
         "wake_open": wake_open,
         "inlet_starved": inlet_starved,
         "enclosed_bubbles": enclosed,
+        **_bubble(r, outer, threshold),
         "oil_area_fraction": float(oil.sum() / free.sum()),
         "mean_alpha": float(np.nanmean(r.alpha[free])),
     }
@@ -488,6 +515,12 @@ def flow_pattern(x: Any, y: Any, alpha: Any, geom: Geometry, threshold: float = 
         outer air touches the rim at ``x > 0`` / ``x < 0``.
     ``enclosed_bubbles``
         number of gas regions (4-connected) not connected to the edge.
+    ``bubble_length_over_a``, ``bubble_width_over_a``, ``bubble_enclosed``
+        the cavitation bubble (:func:`bubble_mask`: the gas touching the island rim
+        downstream): from the downstream point of the Hertzian circle (``x = a``) to the
+        bubble's tip (its largest x, to the interpolated crossing), its full width, and
+        whether oil encloses it (False once it joins the outer air: an open wake). 0.0,
+        0.0 and False without one.
     ``oil_area_fraction``, ``mean_alpha``
         area fraction with ``alpha >= threshold`` and mean alpha, island
         excluded.

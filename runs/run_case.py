@@ -38,7 +38,6 @@ from generator.case_writer import META, CaseGeometry, load_geometry, load_spec_o
 from . import case_fields
 from .foam_runtime import FoamRuntime
 
-LOG = "log.interFoam"
 POLL_S = 1.0
 STOP_GRACE_S = 120.0
 DT_COLLAPSE = 1e-4          # time step below this fraction of maxDeltaT counts as collapse
@@ -51,8 +50,9 @@ class CaseBusy(RuntimeError):
 
 def _steady(history: list[case_fields.Sample], window: float, tol: float,
             length_scale: float) -> bool:
-    """Oil volume within ``tol`` (relative) and meniscus positions within
-    ``tol * length_scale`` (units a) of their values one ``window`` ago."""
+    """Oil volume and bubble volume within ``tol`` (relative to the oil volume), meniscus
+    and bubble-tip positions within ``tol * length_scale`` (units a) of their values one
+    ``window`` ago."""
     if not history or history[-1].time - history[0].time < window * (1 - 1e-9):
         return False
     now = history[-1]
@@ -64,12 +64,16 @@ def _steady(history: list[case_fields.Sample], window: float, tol: float,
     if now.pattern.get("state") != then.pattern.get("state"):
         return False
     for key in ("inlet_meniscus_distance_over_a", "flooded_length_over_a",
-                "flooded_width_over_a", "wake_gas_length_over_a"):
+                "flooded_width_over_a", "wake_gas_length_over_a", "bubble_length_over_a"):
         a, b = now.pattern.get(key), then.pattern.get(key)
         if (a is None) != (b is None):
             return False
         if a is not None and abs(a - b) > tol * length_scale:
             return False
+    # the bubble's volume, relative to the oil volume (a vanishing bubble is steady)
+    a, b = now.pattern.get("bubble_volume_m3"), then.pattern.get("bubble_volume_m3")
+    if a is not None and b is not None and abs(a - b) > tol * max(now.oil_volume, 1e-300):
+        return False
     return True
 
 
@@ -171,16 +175,16 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
     for _, folder in case_fields.time_folders(case):   # a restart: earlier writes count
         history.append(case_fields.sample(folder, structure, geom))
         done.add(folder.name)
-    log_path = case / LOG
+    log_path = case / geom.log_name
     if log_path.exists():
-        log_path.rename(case / f"{LOG}.{int(time.time())}")
+        log_path.rename(case / f"{geom.log_name}.{int(time.time())}")
     tail = LogTail(log_path)
     dt_floor = DT_COLLAPSE * geom.max_delta_t
     t_start = time.monotonic()
     n_procs = spec.run.n_procs
     if n_procs > 1 and not (case / "processor0").is_dir():
         runtime.run("decomposePar", ["-force"], cwd=case, log_path=case / "log.decomposePar")
-    proc = runtime.popen("interFoam", [], cwd=case, log_path=LOG, n_procs=n_procs)
+    proc = runtime.popen(geom.solver, [], cwd=case, log_path=geom.log_name, n_procs=n_procs)
     reason, stopping_since = None, None
     previous = signal.getsignal(signal.SIGTERM)
     signal.signal(signal.SIGTERM, _raise_interrupt)
@@ -307,7 +311,7 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "mesh_gap_mismatch": geom.gap_mismatch,
     }
     if failed:
-        log = case / LOG
+        log = case / geom.log_name
         lines = log.read_text(errors="replace").splitlines()[-20:] if log.exists() else []
         out["log_tail"] = lines
     return out

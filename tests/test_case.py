@@ -189,6 +189,29 @@ def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     assert saved["end_reason"] == "end_time" and saved["time_steps"] == m["time_steps"]
 
 
+def test_cavitating_case_runs_a_few_steps(tmp_path):
+    """The cavitating scene (compressibleInterFoam, air a perfect gas, absolute pressure):
+    builds, runs, and reports the bubble and the lowest pressure."""
+    spec = make_case_spec({**SMALL, "scene": "cavitating"})
+    case = tmp_path / "cav"
+    geom = write_case(spec, case)
+    assert geom.solver == "compressibleInterFoam" and geom.absolute_pressure
+    m = run_case(case, wall_limit=120)
+    assert m["status"] == "finished" and m["end_reason"] == "end_time", m
+    assert (case / "log.compressibleInterFoam").read_text().rstrip().endswith("End")
+    assert m["time_steps"] > 5
+    # the rolling contact pumps: sub-ambient pressure behind it, above the pressure floor
+    p_amb = spec.physics.ambient_pressure
+    assert spec.physics.cavitation_pressure <= m["min_pressure_Pa"] < p_amb
+    for key in ("bubble_length_over_a", "bubble_width_over_a", "bubble_volume_m3"):
+        assert m[key] >= 0.0
+    assert isinstance(m["bubble_enclosed"], bool)
+    assert m["oil_mass_balance_error"] < 0.1
+    assert m["oil_inflow_m3_s"] == pytest.approx(0.02 * 6e-6 * 5e-4, rel=1e-3)
+    header = (case / "history.csv").read_text().splitlines()[0]
+    assert "bubble_volume_m3" in header and "min_pressure_Pa" in header
+
+
 def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:   # a fixed, absurd time step

@@ -279,3 +279,22 @@ def test_bad_inputs_raise():
         Geometry(a=float("nan"), island_radius=A, x_min=-6 * A, x_max=12 * A, y_max=6 * A)
     with pytest.raises(ValueError, match="x_min"):
         Geometry(a=A, island_radius=1.5 * A, x_min=-A, x_max=12 * A, y_max=6 * A)
+
+
+# ------------------------------------------------------------ the cavitation bubble
+def detached_bubble(x, y):  # gas enclosed in the oil but not touching the contact
+    return np.maximum(ring(x, y, 5 * A), -box(x, y, 2.5 * A, 4 * A, 0.8 * A))
+
+
+@pytest.mark.parametrize("field, length, width, enclosed", [
+    (enclosed_bubble, 3.0, 1.6, True),      # tip at x = 4a: l = (4a - a)/a; |y| < 0.8 a
+    (open_wake, 11.0, None, False),         # runs out at x = 12a and joins the outer air
+    (detached_bubble, 0.0, 0.0, False),     # gas, but not attached to the contact exit
+    (ring, 0.0, 0.0, False),                # oil all around
+])
+def test_bubble_metrics_on_known_shapes(field, length, width, enclosed):
+    p = pattern(field)
+    assert p["bubble_length_over_a"] == pytest.approx(length, abs=TOL)
+    assert p["bubble_enclosed"] is enclosed
+    if width is not None:
+        assert p["bubble_width_over_a"] == pytest.approx(width, abs=TOL)
