@@ -5,6 +5,8 @@ Subcommands:
   precalc  the EHL pre-calculation, registered by ``ehl_precalc.cli``
   case     write an OpenFOAM case from a TOML case spec
   run      run a case to steady state and write its metrics.json
+  report   an HTML report (pictures, plots, metrics) of a case or a batch
+  batch    generate, run and report a batch of cases (sweeps, speed ramps)
 
 Exit codes: 0 ok, 1 failure, 2 bad input.
 """
@@ -16,6 +18,8 @@ import sys
 from collections.abc import Sequence
 
 from ehl_precalc import cli as precalc_cli
+from runs import batch_cli
+from runs.report import add_parser as _report_add_parser
 from runs.foam_runtime import (
     FoamConfigError,
     FoamError,
@@ -60,7 +64,7 @@ def cmd_case(args: argparse.Namespace) -> int:
     except CaseExists as err:
         print(f"ehlfoam case: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    print(f"case {args.out}: {geom.cells} cells, a = {geom.a * 1e3:.4f} mm, "
+    print(f"case {args.out}: {geom.solver}, {geom.cells} cells, a = {geom.a * 1e3:.4f} mm, "
           f"transit {geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, "
           f"maxDeltaT {geom.max_delta_t:.3g} s ({geom.capillary_limit}), "
           f"gap mismatch {geom.gap_mismatch:.2%}")
@@ -88,7 +92,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     progress = Progress(TextColumn("{task.description}"), BarColumn(),
                         TextColumn("{task.fields[status]}"), TimeElapsedColumn(),
                         disable=args.quiet or not sys.stdout.isatty())
-    task = progress.add_task(f"interFoam {args.case}", total=1.0, status="starting")
+    task = progress.add_task(f"run {args.case}", total=1.0, status="starting")
 
     def on_sample(sample, geom) -> None:
         p = sample.pattern
@@ -106,21 +110,23 @@ def cmd_run(args: argparse.Namespace) -> int:
         return EXIT_BAD_INPUT
     keys = ("status", "end_reason", "state", "inlet_meniscus_distance_over_a",
             "inlet_meniscus_shape", "flooded_length_over_a", "flooded_width_over_a",
-            "wake_gas_length_over_a", "oil_mass_balance_error", "simulated_time_s",
+            "wake_gas_length_over_a", "bubble_length_over_a", "bubble_enclosed",
+            "min_pressure_Pa", "oil_mass_balance_error", "simulated_time_s",
             "time_steps", "wall_s")
     print(json.dumps({k: metrics.get(k) for k in keys}))
     return EXIT_OK if metrics["status"] == "finished" else EXIT_FAILURE
 
 
 def _sample_line(sample, geom) -> str:
-    """One line per written time: time, transits, state, oil volume, menisci."""
+    """One line per written time: time, transits, state, oil volume, menisci, bubble."""
     p = sample.pattern
     fmt = lambda v: "-" if v is None else f"{v:.2f}"  # noqa: E731
     return (f"t = {sample.time * 1e3:8.2f} ms ({sample.time / geom.transit_time:5.2f} transits)  "
             f"state {p.get('state')}  oil {sample.oil_volume * 1e12:9.4f} nl  "
             f"inlet meniscus {fmt(p.get('inlet_meniscus_distance_over_a'))} a  "
             f"flooded {fmt(p.get('flooded_length_over_a'))} x "
-            f"{fmt(p.get('flooded_width_over_a'))} a")
+            f"{fmt(p.get('flooded_width_over_a'))} a  "
+            f"bubble {fmt(p.get('bubble_length_over_a'))} a")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -165,6 +171,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="wall-clock limit [s] (default: the spec's run.wall_limit)")
     run.add_argument("--quiet", action="store_true", help="no line per written time")
     run.set_defaults(func=cmd_run)
+
+    _report_add_parser(sub)
+    batch_cli.add_parser(sub)
     return parser
 
 
