@@ -1,0 +1,137 @@
+"""Start a ramp step from the previous step's final fields.
+
+A speed ramp runs its steps one after the other; each new case starts from the oil, velocity
+and pressure its predecessor ended with, so that a flow pattern can persist past the speed at
+which it would not form from the standard start (hysteresis).
+
+Consecutive speeds at one load share the base mesh: the Hertzian radius a, hence the domain and
+the in-plane cells, depend on the load only, and the gap heights differ by nanometres. Then the
+final internal fields are copied cell by cell (exact, the equivalent of mapFields on an
+identical mesh). If the meshes differ (other cell count or in-plane positions), OpenFOAM's
+``mapFields -consistent`` interpolates them instead. Either way only the internal fields are
+taken over: the boundary conditions stay those of the new case (walls at the new speed).
+
+The seeded fields are written into the new case's ``0.orig/`` (its initial condition, copied
+to ``0/`` by the run, and by the case's own Allrun), and ``ehlfoam/ramp.json`` records where
+they came from.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from foamlib import FoamFieldFile
+
+from ehl_precalc.outputs import atomic_write_json
+from generator.case_writer import META, load_geometry
+
+from .case_fields import time_folders
+from .foam_runtime import FoamRuntime
+
+#: The fields a ramp step takes over (internal values only) when its 0.orig/ has them:
+#: alpha.oil, U, p_rgh (interFoam), also p and T (compressibleInterFoam).
+FIELDS = ("alpha.oil", "U", "p_rgh", "p", "T")
+#: In-plane cell centres closer than this fraction of a count as the same mesh. A cell's
+#: centroid moves sideways by ~1e-4 a when the gap above it changes by nanometres (measured
+#: 6e-5 a between 10 and 20 mm/s); the smallest cells are 0.055 a (fine level).
+SAME_MESH_TOL = 1e-3
+
+
+class RampError(RuntimeError):
+    """The previous ramp step has nothing to start from."""
+
+
+def final_time(case: str | Path) -> tuple[float, Path]:
+    """The last written time [s] of a finished case and its folder."""
+    folders = time_folders(case)
+    if not folders:
+        raise RampError(f"case {case} has no written time to start a ramp step from")
+    return folders[-1]
+
+
+def same_mesh(case: str | Path, previous: str | Path) -> bool:
+    """True when both cases have the same cells in the same in-plane places (so that the
+    internal fields can be copied cell by cell)."""
+    g_new, g_old = load_geometry(case), load_geometry(previous)
+    if g_new.cells != g_old.cells:
+        return False
+    new, old = np.load(Path(case) / META / "mesh.npz"), np.load(Path(previous) / META / "mesh.npz")
+    for key in ("base_cell", "layer"):
+        if not np.array_equal(new[key], old[key]):
+            return False
+    return bool(np.allclose(new["cell_centres"][:, :2], old["cell_centres"][:, :2], rtol=0.0,
+                            atol=SAME_MESH_TOL * g_new.a))
+
+
+def _read_internal(path: Path) -> Any:
+    return FoamFieldFile(path).internal_field
+
+
+def fields_to_carry(case: Path, folder: Path) -> list[str]:
+    """The fields of :data:`FIELDS` that the new case starts from (its 0.orig/) and the
+    previous case wrote (its final time folder)."""
+    names = [n for n in FIELDS if (case / "0.orig" / n).is_file() and (folder / n).is_file()]
+    if "alpha.oil" not in names:
+        raise RampError(f"no alpha.oil to carry from {folder} into {case}")
+    return names
+
+
+def _copied_fields(folder: Path, names: list[str]) -> dict[str, Any]:
+    return {name: _read_internal(folder / name) for name in names}
+
+
+def _mapped_fields(case: Path, previous: Path, time_name: str, names: list[str],
+                   runtime: FoamRuntime) -> dict[str, Any]:
+    """Internal fields interpolated by ``mapFields -consistent`` onto the new mesh (in a
+    scratch ``0/`` that is removed afterwards)."""
+    zero = case / "0"
+    if zero.exists():
+        shutil.rmtree(zero)
+    shutil.copytree(case / "0.orig", zero)
+    try:
+        runtime.run("mapFields", [str(previous), "-consistent", "-sourceTime", time_name],
+                    cwd=case, log_path=case / "log.mapFields")
+        return {name: _read_internal(zero / name) for name in names}
+    finally:
+        shutil.rmtree(zero, ignore_errors=True)
+
+
+def _write_internal(path: Path, value: Any) -> None:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 1 and len(arr) in (3, 6, 9):
+        # foamlib writes such scalar lists as a vector/tensor (see generator.case_writer)
+        raise RampError(f"{path}: a {len(arr)}-cell field cannot be written safely")
+    with FoamFieldFile(path) as f:
+        f.internal_field = value
+
+
+def seed_from_previous(case: str | Path, previous: str | Path,
+                       runtime: FoamRuntime | None = None) -> dict[str, Any]:
+    """Write ``previous``'s final internal fields (alpha.oil, U, p_rgh; p and T too in a
+    compressible scene) as the initial fields of ``case`` (its ``0.orig/``), by copy on the
+    same mesh, else by mapFields.
+
+    Returns (and writes to ``case/ehlfoam/ramp.json``) {"previous" (relative to the case),
+    "previous_time_s", "method", "fields", "cells"}.
+    """
+    case, previous = Path(case).absolute(), Path(previous).absolute()
+    t, folder = final_time(previous)
+    names = fields_to_carry(case, folder)
+    if same_mesh(case, previous):
+        fields, method = _copied_fields(folder, names), "copy"
+    else:
+        runtime = runtime or FoamRuntime.from_environment()
+        fields = _mapped_fields(case, previous, folder.name, names, runtime)
+        method = "mapFields"
+    for name, value in fields.items():
+        _write_internal(case / "0.orig" / name, value)
+    if (case / "0").exists():      # a stale start folder would shadow 0.orig
+        shutil.rmtree(case / "0")
+    info = {"previous": os.path.relpath(previous, case), "previous_time_s": t, "method": method,
+            "fields": names, "cells": load_geometry(case).cells}
+    atomic_write_json(case / META / "ramp.json", info)
+    return info
