@@ -22,20 +22,10 @@ from generator.case_spec import make_case_spec
 from generator.case_writer import CaseExists, load_geometry, write_case
 from runs.foam_runtime import FoamRuntime
 from runs.run_case import run_case
+from tiny import SMALL
 
 ROOT = Path(__file__).resolve().parent.parent
 EHLFOAM = [str(Path(sys.executable).parent / "ehlfoam")]
-
-SMALL = {
-    "name": "test",
-    # a cheap precalc: the gap outside the island hardly depends on the film's last digits
-    "contact": {"speed": 0.02, "grid": 129, "tol_residual": 1e-4},
-    "mesh": {"resolution": "coarse", "size_rim": 0.25, "size_far": 1.2, "n_layers": 3},
-    "domain": {"upstream": 5.0, "downstream": 7.0, "side": 5.0},
-    "supply": {"mode": "layers", "disc_layer": 3e-6, "ball_layer": 3e-6,
-               "track_half_width": 2.5e-4, "initial_puddle": 3.0},
-    "run": {"end_time": 1e-3, "writes_per_transit": 1000},
-}
 
 
 @pytest.fixture(scope="session")

@@ -32,20 +32,11 @@ from runs.report.fields import load_fields
 from runs.report.side_view import cut_at_axis
 from runs.report.style import AIR_RGB, OIL_RGB
 from runs.run_case import run_case
+from tiny import SMALL
 
 ROOT = Path(__file__).resolve().parent.parent
 
-#: A tiny case: coarse mesh, 3 cells across the gap, a cheap precalc, 1 ms of flow from a
-#: puddle of 3 a around the contact (the inlet meniscus near x = -3 a).
-SPEC = {
-    "name": "report-test",
-    "contact": {"speed": 0.02, "grid": 129, "tol_residual": 1e-4},
-    "mesh": {"resolution": "coarse", "size_rim": 0.25, "size_far": 1.2, "n_layers": 3},
-    "domain": {"upstream": 5.0, "downstream": 7.0, "side": 5.0},
-    "supply": {"mode": "layers", "disc_layer": 3e-6, "ball_layer": 3e-6,
-               "track_half_width": 2.5e-4, "initial_puddle": 3.0},
-    "run": {"end_time": 1e-3, "writes_per_transit": 1000},
-}
+SPEC = {**SMALL, "name": "report-test"}
 LOG_MARKER = "FOAM FATAL ERROR: report-test marker 0xBEEF"
 
 

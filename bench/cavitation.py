@@ -1,0 +1,140 @@
+"""The cavitation bubble behind the contact: the cavitating scene's runs for docs/cavitation.md.
+
+    python bench/cavitation.py [--only NAME ...] [--jobs 2] [--rerun]
+
+Named runs of the reference contact (HVI60, 20 N) in the cavitating scene (compressibleInterFoam,
+air a perfect gas, pMin = the cavitation pressure), each an override set on ``runs/nominal.toml``
+(ample oil: 8 um layers on disc and ball): the thesis's two conditions, thin layers that carry
+air in, a gas seed where no air reaches the contact exit, the mesh levels, the model's constants,
+and the interface scene (incompressible air) beside them. Finished runs are kept (``--rerun``
+recomputes). The bubble metrics are read again from the last written fields with the current
+metrics code, at
+every write of the last transit. Writes ``bench/results/cavitation.json`` and prints a table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from ehl_precalc.outputs import atomic_write_json  # noqa: E402
+from generator.case_spec import load_case_spec  # noqa: E402
+from generator.case_writer import load_geometry, write_case  # noqa: E402
+from runs import case_fields  # noqa: E402
+from runs.run_case import run_case  # noqa: E402
+
+RESULTS = ROOT / "bench" / "results"
+CAV = {"scene": "cavitating", "mesh.resolution": "coarse"}
+U8 = {"contact.speed": 0.008, "contact.temperature": 40.0}
+U20 = {"contact.speed": 0.020, "contact.temperature": 25.0}
+THIN = {"supply.disc_layer": 2e-6, "supply.ball_layer": 2e-6}
+SEED = {"supply.initial_bubble": 1.0}
+L3 = {"supply.disc_layer": 3e-6, "supply.ball_layer": 3e-6}
+
+#: name -> overrides on runs/nominal.toml
+RUNS: dict[str, dict] = {
+    # 1. 40 C, 8 mm/s
+    "u8_8um": {**CAV, **U8},
+    "u8_8um_seed1": {**CAV, **U8, **SEED},
+    "u8_2um": {**CAV, **U8, **THIN},
+    "u8_2um_interface": {**CAV, **U8, **THIN, "scene": "interface"},
+    # 2. 25 C, 20 mm/s: the thesis's bubble (experiment 5 a, Reynolds model 0.9 a)
+    "u20_T25_8um_seed1": {**CAV, **U20, **SEED},
+    "u20_T25_2um": {**CAV, **U20, **THIN},
+    "u20_T25_3um": {**CAV, **U20, **L3},
+    "u20_T25_4um": {**CAV, **U20, "supply.disc_layer": 4e-6, "supply.ball_layer": 4e-6},
+    #    mesh levels and the model's constants, on the 3 um case
+    "u20_T25_3um_medium": {**CAV, **U20, **L3, "mesh.resolution": "medium"},
+    "u20_T25_3um_fine": {**CAV, **U20, **L3, "mesh.resolution": "fine"},
+    "u20_T25_3um_pcav100": {**CAV, **U20, **L3, "physics.cavitation_pressure": 100.0},
+    "u20_T25_3um_pcav10k": {**CAV, **U20, **L3, "physics.cavitation_pressure": 1e4},
+    "u20_T25_3um_K0.75": {**CAV, **U20, **L3, "physics.oil_bulk_modulus": 0.75e9},
+    "u20_T25_3um_K3": {**CAV, **U20, **L3, "physics.oil_bulk_modulus": 3e9},
+    "u20_T25_3um_interface": {**CAV, **U20, **L3, "scene": "interface"},
+}
+KEYS = ("state", "bubble_length_over_a", "bubble_width_over_a", "bubble_volume_m3",
+        "bubble_enclosed", "min_pressure_Pa", "wake_open", "inlet_meniscus_distance_over_a",
+        "inlet_meniscus_shape", "oil_mass_balance_error", "end_reason", "steady",
+        "simulated_time_s", "transit_time_s", "time_steps", "cells", "wall_s")
+
+
+def _cpu(case: Path) -> float | None:
+    logs = sorted(case.glob("log.*Foam"))
+    if not logs:
+        return None
+    times = re.findall(r"^ExecutionTime = ([0-9.eE+-]+) s", logs[0].read_text(errors="replace"), re.M)
+    return float(times[-1]) if times else None
+
+
+def _last_transit(case: Path) -> dict:
+    """The flow pattern of the last written time and the bubble over the last transit (mean,
+    min, max of its length and volume), measured again with the current metrics code."""
+    folders = case_fields.time_folders(case)
+    if not folders:
+        return {}
+    geom = load_geometry(case)
+    structure = case_fields.Structure.load(case)
+    t_end = folders[-1][0]
+    window = [f for t, f in folders if t >= t_end - geom.transit_time * (1 + 1e-9)]
+    samples = [case_fields.sample(f, structure, geom).pattern for f in window]
+    out = dict(samples[-1])
+    for key in ("bubble_length_over_a", "bubble_volume_m3"):
+        v = [p[key] for p in samples]
+        out[f"{key}_last_transit"] = {"mean": sum(v) / len(v), "min": min(v), "max": max(v),
+                                      "n": len(v)}
+    out["bubble_enclosed_last_transit"] = sum(p["bubble_enclosed"] for p in samples) / len(samples)
+    return out
+
+
+def one(job: tuple[str, Path, bool]) -> dict:
+    name, work, rerun = job
+    case = work / name
+    done = case / "metrics.json"
+    status = json.loads(done.read_text()).get("status") if done.is_file() else None
+    if rerun or status not in ("finished", "failed"):
+        spec = load_case_spec(ROOT / "runs" / "nominal.toml", **RUNS[name], name=name)
+        write_case(spec, case, overwrite=True)
+        run_case(case)
+    m = json.loads(done.read_text())
+    m.update(_last_transit(case))
+    return {"name": name, "overrides": RUNS[name], "cpu_s": _cpu(case),
+            **{k: m.get(k) for k in KEYS},
+            **{k: v for k, v in m.items() if k.endswith("_last_transit")}}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", nargs="+", choices=sorted(RUNS), default=None)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--rerun", action="store_true", help="recompute finished runs")
+    ap.add_argument("--work", default=str(ROOT / "runs" / "bench" / "cavitation"))
+    args = ap.parse_args(argv)
+    names = args.only or list(RUNS)
+    jobs = [(n, Path(args.work), args.rerun) for n in names]
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        rows = list(pool.map(one, jobs))
+    out = RESULTS / "cavitation.json"
+    old = json.loads(out.read_text())["rows"] if out.is_file() else []
+    merged = {r["name"]: r for r in old} | {r["name"]: r for r in rows}
+    atomic_write_json(out, {"rows": [merged[n] for n in RUNS if n in merged]})
+    fmt = lambda v: f"{v:.4g}" if isinstance(v, float) else str(v)  # noqa: E731
+    head = ("name", "state", "bubble_length_over_a", "bubble_enclosed", "min_pressure_Pa",
+            "oil_mass_balance_error", "end_reason", "cells", "cpu_s")
+    print(" | ".join(head) + " | l/a over the last transit: mean (min-max), enclosed share")
+    for r in rows:
+        lt = r.get("bubble_length_over_a_last_transit") or {}
+        extra = (f"{lt['mean']:.2f} ({lt['min']:.2f}-{lt['max']:.2f}), "
+                 f"{r.get('bubble_enclosed_last_transit'):.0%}") if lt else "-"
+        print(" | ".join(fmt(r.get(k)) for k in head) + " | " + extra)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
