@@ -231,11 +231,16 @@ def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, supply: np.ndarray,
 def _edit_thermo_fields(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
     """The cavitating scene's absolute pressure (ambient at the open boundaries) and T."""
     p_amb, temp = spec.physics.ambient_pressure, spec.temperature_k
+    # boundary values are written out (not $internalField): a ramp step replaces the internal
+    # field by a list, and v1912 cannot expand a list macro twice
     with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
         f.internal_field = p_amb
+        f.boundary_field['"(disc|ball|island|supply)"']["value"] = p_amb
         f.boundary_field['"(inlet|outlet|side)"']["p0"] = p_amb
+        f.boundary_field['"(inlet|outlet|side)"']["value"] = p_amb
     with FoamFieldFile(case / "0.orig" / "p") as f:
         f.internal_field = p_amb
+        f.boundary_field['".*"']["value"] = p_amb
         if not geom.symmetric:
             del f.boundary_field["symmetry"]
     with FoamFieldFile(case / "0.orig" / "T") as f:

@@ -202,6 +202,25 @@ def test_cavitating_case_runs_a_few_steps(tmp_path):
     assert "bubble_volume_m3" in header and "min_pressure_Pa" in header
 
 
+def test_cavitating_case_starts_from_another_cases_fields(tmp_path):
+    """A ramp step of the cavitating scene: the previous case's final fields (lists, p and T
+    included) as the start; the case must read them (no $internalField in list fields)."""
+    from runs.ramp import seed_from_previous
+
+    first, second = tmp_path / "first", tmp_path / "second"
+    write_case(make_case_spec({**SMALL, "scene": "cavitating"}), first)
+    assert run_case(first, wall_limit=120)["status"] == "finished"
+    faster = make_case_spec({**SMALL, "scene": "cavitating",
+                             "contact": {**SMALL["contact"], "speed": 0.025}})
+    write_case(faster, second)
+    info = seed_from_previous(second, first)
+    assert info["method"] == "copy" and {"p", "p_rgh", "T", "alpha.oil", "U"} <= set(info["fields"])
+    m = run_case(second, wall_limit=120)
+    assert m["status"] == "finished", m.get("log_tail")
+    assert m["oil_volume_initial_m3"] == pytest.approx(
+        json.loads((first / "metrics.json").read_text())["oil_volume_m3"], rel=1e-6)
+
+
 def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:   # a fixed, absurd time step
