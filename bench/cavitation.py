@@ -28,7 +28,7 @@ from ehl_precalc.outputs import atomic_write_json  # noqa: E402
 from generator.case_spec import load_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
 from runs import case_fields  # noqa: E402
-from runs.run_case import run_case  # noqa: E402
+from runs.run_case import mass_balance, run_case  # noqa: E402
 
 RESULTS = ROOT / "bench" / "results"
 CAV = {"scene": "cavitating", "mesh.resolution": "coarse"}
@@ -59,7 +59,7 @@ RUNS: dict[str, dict] = {
     "u20_T25_3um_K3": {**CAV, **U20, **L3, "physics.oil_bulk_modulus": 3e9},
     "u20_T25_3um_interface": {**CAV, **U20, **L3, "scene": "interface"},
 }
-KEYS = ("state", "bubble_length_over_a", "bubble_width_over_a", "bubble_volume_m3",
+KEYS = ("state", "gas_mass_balance_error", "bubble_length_over_a", "bubble_width_over_a", "bubble_volume_m3",
         "bubble_enclosed", "min_pressure_Pa", "wake_open", "inlet_meniscus_distance_over_a",
         "inlet_meniscus_shape", "oil_mass_balance_error", "end_reason", "steady",
         "simulated_time_s", "transit_time_s", "time_steps", "cells", "wall_s")
@@ -71,6 +71,17 @@ def _cpu(case: Path) -> float | None:
         return None
     times = re.findall(r"^ExecutionTime = ([0-9.eE+-]+) s", logs[0].read_text(errors="replace"), re.M)
     return float(times[-1]) if times else None
+
+
+def _balances(case: Path) -> dict:
+    """Oil and gas mass balances over the whole run, from every written time (the runs made
+    before the monitor followed the gas are measured again here)."""
+    geom = load_geometry(case)
+    structure = case_fields.Structure.load(case)
+    history = [case_fields.sample(f, structure, geom) for _, f in case_fields.time_folders(case)]
+    b = mass_balance(history)
+    return {k: b.get(k) for k in ("oil_mass_balance_error", "gas_mass_balance_error",
+                                  "gas_carried_in_kg", "gas_carried_out_kg")}
 
 
 def _last_transit(case: Path) -> dict:
@@ -104,6 +115,7 @@ def one(job: tuple[str, Path, bool]) -> dict:
         run_case(case)
     m = json.loads(done.read_text())
     m.update(_last_transit(case))
+    m.update(_balances(case))
     return {"name": name, "overrides": RUNS[name], "cpu_s": _cpu(case),
             **{k: m.get(k) for k in KEYS},
             **{k: v for k, v in m.items() if k.endswith("_last_transit")}}

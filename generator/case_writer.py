@@ -32,6 +32,11 @@ from .mesh import (MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
 META = "ehlfoam"  # the case's own folder of generator outputs
 
+#: The air of the cavitating scene, a perfect gas: molar mass [kg/mol] (the template's
+#: molWeight) and specific gas constant [J/(kg K)].
+AIR_MOLAR_MASS = 28.9e-3
+AIR_GAS_CONSTANT = 8.314462618 / AIR_MOLAR_MASS
+
 #: Galusinski & Vigneaux (2008) constants of the capillary time-step limit.
 GV_C1, GV_C2 = 0.01, 10.0
 
@@ -310,6 +315,7 @@ def _edit_thermo(spec: CaseSpec, case: Path) -> None:
         f["mixture"]["transport"]["mu"] = spec.oil_viscosity
     with FoamFile(const / "thermophysicalProperties.air") as f:
         f["mixture"]["transport"]["mu"] = p.air_viscosity * spec.run.air_viscosity_factor
+        f["mixture"]["specie"]["molWeight"] = AIR_MOLAR_MASS * 1e3
 
 
 def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int, solver: str) -> None:

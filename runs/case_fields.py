@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from foamlib import FoamFieldFile
 
-from generator.case_writer import META, CaseGeometry
+from generator.case_writer import AIR_GAS_CONSTANT, META, CaseGeometry
 
 from . import metrics
 
@@ -88,14 +88,20 @@ class Sample:
     oil_in: float           # m3/s of oil entering through the open boundaries
     oil_out: float          # m3/s of oil leaving
     pattern: dict
+    gas_mass: float | None = None   # kg of air, whole contact (compressible scenes only)
+    gas_in: float | None = None     # kg/s of air entering through the open boundaries
+    gas_out: float | None = None    # kg/s of air leaving
 
     def row(self) -> dict:
         keys = ("state", "inlet_meniscus_distance_over_a", "flooded_length_over_a",
                 "flooded_width_over_a", "wake_gas_length_over_a", "enclosed_bubbles",
                 "bubble_length_over_a", "bubble_volume_m3", "min_pressure_Pa")
+        gas = ({} if self.gas_mass is None else
+               {"gas_mass_kg": self.gas_mass, "gas_in_kg_s": self.gas_in,
+                "gas_out_kg_s": self.gas_out})
         return {"time_s": self.time, "oil_volume_m3": self.oil_volume,
                 "oil_in_m3_s": self.oil_in, "oil_out_m3_s": self.oil_out,
-                **{k: self.pattern.get(k) for k in keys}}
+                **{k: self.pattern.get(k) for k in keys}, **gas}
 
 
 def pattern_geometry(geom: CaseGeometry) -> metrics.Geometry:
@@ -164,8 +170,38 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     pattern = metrics.flow_pattern_from_raster(r)
     pattern["bubble_volume_m3"] = _bubble_volume(r, alpha, structure, geom)
     pattern["min_pressure_Pa"] = _min_pressure(folder, structure, geom)
+    gas = _gas(folder, alpha, structure, geom) if geom.absolute_pressure else {}
     return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
-                  pattern=pattern)
+                  pattern=pattern, **gas)
+
+
+def _gas(folder: Path, alpha: np.ndarray, structure: Structure, geom: CaseGeometry) -> dict:
+    """Air mass [kg] in the gap and its mass fluxes [kg/s] in and out through the open
+    boundaries (whole contact) of a compressible scene: density p/(R T) of the perfect gas,
+    volumetric gas flux phi - alphaPhi0.oil on the boundary faces."""
+    n = len(structure.cell_volumes)
+    p = _uniform_or_list(FoamFieldFile(_complete(folder / "p")).internal_field, n)
+    temp = _uniform_or_list(FoamFieldFile(_complete(folder / "T")).internal_field, n)
+    mirror = 2.0 if geom.symmetric else 1.0
+    gas = 1.0 - np.clip(alpha, 0.0, 1.0)
+    mass = mirror * float(np.sum(gas * p / (AIR_GAS_CONSTANT * temp) * structure.cell_volumes))
+    phi = FoamFieldFile(_complete(folder / "phi")).boundary_field
+    oil = FoamFieldFile(_complete(folder / "alphaPhi0.oil")).boundary_field
+    p_b = FoamFieldFile(folder / "p").boundary_field
+    t_b = FoamFieldFile(folder / "T").boundary_field
+    m_in = m_out = 0.0
+    for name in OPEN_PATCHES:
+        if name not in structure.patches:
+            continue
+        size = structure.patches[name][1]
+        q = (_uniform_or_list(phi[name]["value"], size)
+             - _uniform_or_list(oil[name]["value"], size))          # outward, m3/s per face
+        rho = (_uniform_or_list(p_b[name]["value"], size)
+               / (AIR_GAS_CONSTANT * _uniform_or_list(t_b[name]["value"], size)))
+        flux = rho * q
+        m_in += mirror * float(-flux[flux < 0].sum())
+        m_out += mirror * float(flux[flux > 0].sum())
+    return {"gas_mass": mass, "gas_in": m_in, "gas_out": m_out}
 
 
 def _bubble_volume(r: metrics.Raster, alpha: np.ndarray, structure: Structure,

@@ -120,25 +120,37 @@ def _write_history(case: Path, history: list[case_fields.Sample]) -> None:
     atomic_write_text(case / "history.csv", buf.getvalue())
 
 
-def _mass_balance(v0: float, history: list[case_fields.Sample]) -> dict:
-    """Oil volume change against the time integral of the oil fluxes through the open
-    boundaries, from the first to the last written time (trapezoid over the writes; before
-    the first write the fluxes are not known). The error is relative to the oil carried in
-    over that window (or to the oil volume when almost nothing came in)."""
+def _balance(amount: list[float], ins: list[float], outs: list[float], t: np.ndarray,
+             what: str, unit: str) -> dict:
+    """``amount`` change against the time integral of the fluxes through the open boundaries,
+    from the first to the last written time (trapezoid over the writes; before the first
+    write the fluxes are not known). The error is relative to what came in over that window
+    (or to the amount when almost nothing came in)."""
+    carried_in = float(np.trapezoid(ins, t))
+    carried_out = float(np.trapezoid(outs, t))
+    residual = amount[-1] - amount[0] - (carried_in - carried_out)
+    by_inflow = carried_in > 0.01 * amount[-1]
+    scale = carried_in if by_inflow else amount[-1]
+    return {f"{what}_carried_in_{unit}": carried_in, f"{what}_carried_out_{unit}": carried_out,
+            f"{what}_mass_balance_residual_{unit}": residual,
+            f"{what}_mass_balance_error": abs(residual) / scale if scale > 0 else None,
+            f"{what}_mass_balance_reference": f"{what} carried in" if by_inflow else f"{what} amount",
+            f"{what}_mass_balance_window_s": [float(t[0]), float(t[-1])]}
+
+
+def mass_balance(history: list[case_fields.Sample]) -> dict:
+    """The oil balance (volumes: the oil is incompressible or nearly so) and, in a compressible
+    scene, the air's (masses)."""
     if len(history) < 2:
         return {"oil_carried_in_m3": None, "oil_carried_out_m3": None,
                 "oil_mass_balance_error": None}
     t = np.array([s.time for s in history])
-    carried_in = float(np.trapezoid([s.oil_in for s in history], t))
-    carried_out = float(np.trapezoid([s.oil_out for s in history], t))
-    residual = history[-1].oil_volume - history[0].oil_volume - (carried_in - carried_out)
-    by_inflow = carried_in > 0.01 * history[-1].oil_volume
-    scale = carried_in if by_inflow else history[-1].oil_volume
-    return {"oil_carried_in_m3": carried_in, "oil_carried_out_m3": carried_out,
-            "oil_mass_balance_residual_m3": residual,
-            "oil_mass_balance_error": abs(residual) / scale if scale > 0 else None,
-            "oil_mass_balance_reference": "oil carried in" if by_inflow else "oil volume",
-            "oil_mass_balance_window_s": [float(t[0]), float(t[-1])]}
+    out = _balance([s.oil_volume for s in history], [s.oil_in for s in history],
+                   [s.oil_out for s in history], t, "oil", "m3")
+    if all(s.gas_mass is not None for s in history):
+        out |= _balance([s.gas_mass for s in history], [s.gas_in for s in history],
+                        [s.gas_out for s in history], t, "gas", "kg")
+    return out
 
 
 def run_case(case: str | Path, runtime: FoamRuntime | None = None,
@@ -296,7 +308,7 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "oil_volume_initial_m3": v0,
         "oil_inflow_m3_s": last.oil_in if last else None,
         "oil_outflow_m3_s": last.oil_out if last else None,
-        **_mass_balance(v0, history),
+        **mass_balance(history),
         "contact_flow_m3_s": geom.contact_flow,
         "contact_flow_over_inflow": (geom.contact_flow / last.oil_in
                                      if last and last.oil_in > 0 else None),

@@ -198,6 +198,7 @@ def test_cavitating_case_runs_a_few_steps(tmp_path):
     assert isinstance(m["bubble_enclosed"], bool)
     assert m["oil_mass_balance_error"] < 0.1
     assert m["oil_inflow_m3_s"] == pytest.approx(0.02 * 6e-6 * 5e-4, rel=1e-3)
+    assert m["gas_mass_balance_error"] < 0.05       # the air: p/(R T) times the gas fluxes
     header = (case / "history.csv").read_text().splitlines()[0]
     assert "bubble_volume_m3" in header and "min_pressure_Pa" in header
 
