@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from runs.case_fields import Sample
-from runs.run_case import _mass_balance, _steady
+from runs.run_case import _steady, mass_balance
 
 
 def history(volumes, menisci, dt=0.01, state="I"):
@@ -44,8 +44,8 @@ def test_mass_balance_closes_for_a_consistent_history():
     # volume grows at q_in - q_out = 2 - 1 = 1 per second
     h = [Sample(time=t, oil_volume=5.0 + t, oil_in=2.0, oil_out=1.0, pattern={})
          for t in (0.1, 0.2, 0.3, 0.4)]
-    mb = _mass_balance(5.0, h)
+    mb = mass_balance(h)
     assert mb["oil_carried_in_m3"] == pytest.approx(0.6)
     assert mb["oil_mass_balance_error"] == pytest.approx(0.0, abs=1e-12)
     h[-1].oil_volume += 0.06     # 10 % of the oil carried in, lost or gained
-    assert _mass_balance(5.0, h)["oil_mass_balance_error"] == pytest.approx(0.1)
+    assert mass_balance(h)["oil_mass_balance_error"] == pytest.approx(0.1)
