@@ -26,7 +26,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from runs.batch import BatchOptions, read_results, run_batch  # noqa: E402
+from runs.batch import BatchOptions, run_batch  # noqa: E402
+from runs.batch_results import read_results  # noqa: E402
 from runs.batch_spec import load_plan  # noqa: E402
 
 RESULTS = ROOT / "bench" / "results"

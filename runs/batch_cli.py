@@ -78,7 +78,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
     """Run (or dry-run) the batch; exit code as in the module doc."""
     from ehl_precalc.spec import SpecError
 
-    from .batch import BatchError, BatchOptions, dry_run, parse_slurm, run_batch
+    from .batch import BatchError, BatchOptions, dry_run, run_batch
+    from .batch_executors import parse_slurm
 
     try:
         if args.dry_run:

@@ -424,7 +424,7 @@ def write_regime(batch_dir: str | Path, rows: Iterable[dict] | None = None) -> d
     ``regime/hysteresis.png`` (those with something to draw). Returns the analysis."""
     batch_dir = Path(batch_dir)
     if rows is None:
-        from .batch import read_results
+        from .batch_results import read_results
 
         rows = read_results(batch_dir)
     result = analyse(rows)

@@ -25,8 +25,10 @@ from foamlib import FoamFieldFile
 from generator.case_spec import make_case_spec
 from generator.case_writer import load_geometry, write_case
 from runs import batch_cli, case_fields
-from runs.batch import (CASES, FIXED_COLUMNS, BatchError, BatchOptions, parse_slurm,
-                        read_results, run_batch, slurm_cluster)
+from runs.batch import BatchError, BatchOptions, run_batch
+from runs.batch_executors import parse_slurm, slurm_cluster
+from runs.batch_folder import CASES
+from runs.batch_results import FIXED_COLUMNS, read_results
 from runs.case_fields import time_folders
 from runs.ramp import seed_from_previous
 
