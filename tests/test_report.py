@@ -260,7 +260,8 @@ def batch(finished_case, case_report, tmp_path_factory) -> Path:
     (root / "plan.json").write_text(json.dumps(plan))
     (root / "regime").mkdir()
     shutil.copy(ok / "report" / "thumb.png", root / "regime" / "map.png")
-    (root / "regime" / "regime.json").write_text(json.dumps({"transition_speed_mm_s": 12.5}))
+    (root / "regime" / "regime.json").write_text(json.dumps(
+        {"summary": ["T 40 C, F 20 N, 1um, coarse: I -> II at 12.5 +- 2.5 mm/s"]}))
     return root
 
 
@@ -279,7 +280,7 @@ def test_batch_report_index_failures_and_reuse(batch):
     assert (index.parent / "../cases/bad/log.interFoam").resolve().is_file()
     assert LOG_MARKER in html                                  # its last log line
     assert "later" in html and "pending" in html
-    assert "transition_speed_mm_s" in html and "12.5" in html   # regime.json
+    assert "I -&gt; II at 12.5 +- 2.5 mm/s" in html              # regime.json's summary
     assert 'src="../regime/map.png"' in html
     assert "not enough points" in html                          # one state I point only
     for src in re.findall(r'<img src="([^"]+)"', html):

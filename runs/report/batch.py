@@ -373,10 +373,11 @@ def _regime(batch: Path, out: Path, page: Page) -> None:
         data = json.loads((regime / "regime.json").read_text())
     except (OSError, ValueError):
         return
-    flat = units.flatten(data) if isinstance(data, dict) else {"regime": data}
-    rows = [[k, cell(units.fmt_number(v) if not isinstance(v, list) or len(v) < 12
-                     else f"{len(v)} values", num=True)] for k, v in flat.items()]
-    page.tables.insert(0, Table("Regime (regime/regime.json)", ["key", "value"], rows))
+    if not isinstance(data, dict):
+        return
+    rows = [[cell(line)] for line in data.get("summary", [])]
+    page.tables.insert(0, Table("Transitions I -> II (regime/regime.json)",
+                                ["line or ramp branch: transition speed"], rows))
 
 
 def report_batch(batch_dir: str | os.PathLike, *, jobs: int | None = None,
