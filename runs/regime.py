@@ -193,8 +193,9 @@ def _ramps(rows: Iterable[dict]) -> list[dict[str, Any]]:
         ups = [r for r in rs if r.get("ramp_direction") == "up"]
         downs = [r for r in rs if r.get("ramp_direction") == "down"]
         # each branch includes the turning point it starts from
-        up = _branch(rs, "up", downs[-1] if first == "down" and downs else None)
-        down = _branch(rs, "down", ups[-1] if first == "up" and ups else None)
+        # a one-way ramp has one branch (the other would be its turning point alone)
+        up = _branch(rs, "up", downs[-1] if first == "down" and downs else None) if ups else None
+        down = _branch(rs, "down", ups[-1] if first == "up" and ups else None) if downs else None
         r0 = rs[0]
         entry = {"name": name, "temperature_C": _float(r0.get("temperature_C")),
                  "load_N": _float(r0.get("load_N")), "supply": supply_label(r0),
@@ -220,7 +221,7 @@ def summary_lines(result: dict) -> list[str]:
                      f"{ln['resolution']}: {_fmt_t(ln)}")
     for rp in result["ramps"]:
         text = (f"ramp {rp['name']} ({rp['supply']}, T {rp['temperature_C']:g} C): "
-                f"up {_fmt_t(rp['up'])}; down {_fmt_t(rp['down'])}")
+                + "; ".join(f"{d} {_fmt_t(rp[d])}" for d in ("up", "down") if rp[d]))
         h = rp.get("hysteresis")
         if h:
             if h["width_mm_s"] is not None:
@@ -315,7 +316,7 @@ def _ramp_rows(result: dict, T: float, F: float, res: str) -> list[tuple[str, di
             continue
         for direction in ("up", "down"):
             branch = rp[direction]
-            if len(branch["speeds_mm_s"]) > (1 if direction == "down" else 0):
+            if branch and len(branch["speeds_mm_s"]) > (1 if direction == "down" else 0):
                 arrow = "->" if direction == "up" else "<-"
                 out.append((f"{rp['supply']} ramp {rp['name']} {direction} {arrow}",
                             _directed(branch, direction), True))

@@ -91,6 +91,16 @@ def test_ramp_without_hysteresis_and_without_transition():
     assert "width not determined" in never["hysteresis"]["note"]
 
 
+def test_one_way_ramp_has_one_branch(tmp_path):
+    rows = _ramp_rows("I I II".split(), [], speeds=(8, 14, 20))
+    rp = analyse(rows)["ramps"][0]
+    assert rp["down"] is None and "hysteresis" not in rp
+    assert rp["up"]["transition_mm_s"] == 17.0 and rp["up"]["uncertainty_mm_s"] == 3.0
+    summary = analyse(rows)["summary"][0]
+    assert "up I -> II at 17" in summary and "down" not in summary
+    write_regime(tmp_path, rows)          # draws without a down branch
+
+
 def test_hysteresis_function_directly():
     up = transition([5, 8, 12], ["I", "I", "II"])
     down = transition([12, 8, 5], ["II", "I", "I"])
