@@ -76,8 +76,8 @@ def _png(path: Path) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ the case report
-def test_case_report_has_every_part_and_is_fast(case_report, finished_case):
-    index, wall = case_report
+def test_case_report_has_every_part(case_report, finished_case):
+    index, _ = case_report
     assert index == finished_case / "report" / "index.html"
     html = index.read_text()
     for name in ("top_view.png", "side_view.png", "pressure.png", "ehl_precalc.png",
@@ -95,7 +95,7 @@ def test_case_report_has_every_part_and_is_fast(case_report, finished_case):
     assert "<td>nl</td>" in html and "<td>mm/s</td>" in html
     assert f"{metrics['cells']:,}" in html
     assert "interFoam" in html and "OPENFOAM=" in html            # solver and build
-    assert wall < 30.0, f"case report took {wall:.1f} s"
+    # (its cost is measured by bench/report_bench.py, not asserted here)
 
 
 def test_top_view_meniscus_lies_where_the_metrics_say(case_report, finished_case):
