@@ -75,6 +75,11 @@ class CaseGeometry:
     ambient_pressure: float = 1.013e5
 
     @property
+    def mirror(self) -> float:
+        """Factor from the meshed domain to the whole contact: 2 for a half domain, else 1."""
+        return 2.0 if self.symmetric else 1.0
+
+    @property
     def absolute_pressure(self) -> bool:
         """The solver's p is absolute (compressible scenes), else gauge (0 = ambient)."""
         return self.solver.startswith("compressible")

@@ -122,8 +122,7 @@ def _read_alpha(path: Path, structure: Structure) -> tuple[np.ndarray, FoamField
 
 def _oil_volume(alpha: np.ndarray, structure: Structure, geom: CaseGeometry) -> float:
     """Oil volume [m3] of the whole contact (doubled in a half domain)."""
-    mirror = 2.0 if geom.symmetric else 1.0
-    return mirror * float(np.sum(np.clip(alpha, 0.0, 1.0) * structure.cell_volumes))
+    return geom.mirror * float(np.sum(np.clip(alpha, 0.0, 1.0) * structure.cell_volumes))
 
 
 def mid_gap_alpha(folder: Path, structure: Structure, geom: CaseGeometry) -> np.ndarray:
@@ -150,57 +149,65 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
             _complete(folder / name)
     alpha, alpha_file = _read_alpha(folder / "alpha.oil", structure)
     volume = _oil_volume(alpha, structure, geom)
-    mirror = 2.0 if geom.symmetric else 1.0
     # the oil flux MULES transported (alphaPhi0.oil); phi * face alpha where it is absent
     oil_flux_file = folder / "alphaPhi0.oil"
     flux_bf = FoamFieldFile(oil_flux_file if oil_flux_file.exists() else folder / "phi").boundary_field
     alpha_bf = alpha_file.boundary_field
-    q_in = q_out = 0.0
-    for name in OPEN_PATCHES:
-        if name not in structure.patches:
-            continue
-        size = structure.patches[name][1]
-        flux = _uniform_or_list(flux_bf[name]["value"], size)   # outward, per face
+
+    def oil_flux(name: str, size: int) -> np.ndarray:
+        flux = _uniform_or_list(flux_bf[name]["value"], size)
         if not oil_flux_file.exists():
             flux = flux * np.clip(_uniform_or_list(alpha_bf[name]["value"], size), 0.0, 1.0)
-        q_in += mirror * float(-flux[flux < 0].sum())
-        q_out += mirror * float(flux[flux > 0].sum())
+        return flux
+
+    q_in, q_out = _in_out(oil_flux, structure, geom)
     mid = structure.mid_gap(alpha, geom.n_layers)
     r = metrics.raster(structure.base_x, structure.base_y, mid, pattern_geometry(geom))
     pattern = metrics.flow_pattern_from_raster(r)
     pattern["bubble_volume_m3"] = _bubble_volume(r, alpha, structure, geom)
-    pattern["min_pressure_Pa"] = _min_pressure(folder, structure, geom)
-    gas = _gas(folder, alpha, structure, geom) if geom.absolute_pressure else {}
+    p_file = folder / "p"
+    p = (_uniform_or_list(FoamFieldFile(_complete(p_file)).internal_field, len(alpha))
+         if p_file.exists() else None)
+    pattern["min_pressure_Pa"] = _min_pressure(p, geom)
+    gas = _gas(folder, alpha, p, structure, geom) if geom.absolute_pressure else {}
     return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
                   pattern=pattern, **gas)
 
 
-def _gas(folder: Path, alpha: np.ndarray, structure: Structure, geom: CaseGeometry) -> dict:
-    """Air mass [kg] in the gap and its mass fluxes [kg/s] in and out through the open
-    boundaries (whole contact) of a compressible scene: density p/(R T) of the perfect gas,
-    volumetric gas flux phi - alphaPhi0.oil on the boundary faces."""
-    n = len(structure.cell_volumes)
-    p = _uniform_or_list(FoamFieldFile(_complete(folder / "p")).internal_field, n)
-    temp = _uniform_or_list(FoamFieldFile(_complete(folder / "T")).internal_field, n)
-    mirror = 2.0 if geom.symmetric else 1.0
-    gas = 1.0 - np.clip(alpha, 0.0, 1.0)
-    mass = mirror * float(np.sum(gas * p / (AIR_GAS_CONSTANT * temp) * structure.cell_volumes))
-    phi = FoamFieldFile(_complete(folder / "phi")).boundary_field
-    oil = FoamFieldFile(_complete(folder / "alphaPhi0.oil")).boundary_field
-    p_b = FoamFieldFile(folder / "p").boundary_field
-    t_b = FoamFieldFile(folder / "T").boundary_field
-    m_in = m_out = 0.0
+def _in_out(face_flux, structure: Structure, geom: CaseGeometry) -> tuple[float, float]:
+    """What enters and what leaves (whole contact) through the open boundaries, for
+    ``face_flux(patch, size)``: the outward flux of each face of a patch."""
+    q_in = q_out = 0.0
     for name in OPEN_PATCHES:
         if name not in structure.patches:
             continue
-        size = structure.patches[name][1]
+        flux = face_flux(name, structure.patches[name][1])
+        q_in += float(-flux[flux < 0].sum())
+        q_out += float(flux[flux > 0].sum())
+    return geom.mirror * q_in, geom.mirror * q_out
+
+
+def _gas(folder: Path, alpha: np.ndarray, p: np.ndarray, structure: Structure,
+         geom: CaseGeometry) -> dict:
+    """Air mass [kg] in the gap and its mass fluxes [kg/s] in and out through the open
+    boundaries (whole contact) of a compressible scene: density p/(R T) of the perfect gas
+    (``p`` [Pa] per cell), volumetric gas flux phi - alphaPhi0.oil on the boundary faces."""
+    temp_file = FoamFieldFile(_complete(folder / "T"))
+    temp = _uniform_or_list(temp_file.internal_field, len(alpha))
+    gas = 1.0 - np.clip(alpha, 0.0, 1.0)
+    mass = geom.mirror * float(np.sum(gas * p / (AIR_GAS_CONSTANT * temp) * structure.cell_volumes))
+    phi = FoamFieldFile(_complete(folder / "phi")).boundary_field
+    oil = FoamFieldFile(_complete(folder / "alphaPhi0.oil")).boundary_field
+    p_b, t_b = FoamFieldFile(folder / "p").boundary_field, temp_file.boundary_field
+
+    def gas_mass_flux(name: str, size: int) -> np.ndarray:
         q = (_uniform_or_list(phi[name]["value"], size)
              - _uniform_or_list(oil[name]["value"], size))          # outward, m3/s per face
         rho = (_uniform_or_list(p_b[name]["value"], size)
                / (AIR_GAS_CONSTANT * _uniform_or_list(t_b[name]["value"], size)))
-        flux = rho * q
-        m_in += mirror * float(-flux[flux < 0].sum())
-        m_out += mirror * float(flux[flux > 0].sum())
+        return rho * q
+
+    m_in, m_out = _in_out(gas_mass_flux, structure, geom)
     return {"gas_mass": mass, "gas_in": m_in, "gas_out": m_out}
 
 
@@ -213,18 +220,15 @@ def _bubble_volume(r: metrics.Raster, alpha: np.ndarray, structure: Structure,
     ix = np.clip(np.rint((structure.base_x - r.x[0]) / r.dx).astype(int), 0, len(r.x) - 1)
     iy = np.clip(np.rint((structure.base_y - r.y[0]) / r.dy).astype(int), 0, len(r.y) - 1)
     under = mask[iy, ix][structure.base_cell]
-    mirror = 2.0 if geom.symmetric else 1.0
     gas = 1.0 - np.clip(alpha, 0.0, 1.0)
-    return mirror * float(np.sum(gas[under] * structure.cell_volumes[under]))
+    return geom.mirror * float(np.sum(gas[under] * structure.cell_volumes[under]))
 
 
-def _min_pressure(folder: Path, structure: Structure, geom: CaseGeometry) -> float | None:
-    """Lowest absolute pressure [Pa] in the cells: the cavitating scene's p is absolute, the
-    interface scene's is gauge (ambient added). None when p was not written."""
-    path = folder / "p"
-    if not path.exists():
+def _min_pressure(p: np.ndarray | None, geom: CaseGeometry) -> float | None:
+    """Lowest absolute pressure [Pa] of the cell pressures ``p``: the cavitating scene's p is
+    absolute, the interface scene's is gauge (ambient added). None when p was not written."""
+    if p is None:
         return None
-    p = _uniform_or_list(FoamFieldFile(_complete(path)).internal_field, len(structure.cell_volumes))
     offset = 0.0 if geom.absolute_pressure else geom.ambient_pressure
     return float(p.min() + offset)
 
