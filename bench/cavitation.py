@@ -16,13 +16,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+
+from common import solver_cpu_s  # noqa: E402
 
 from ehl_precalc.outputs import atomic_write_json  # noqa: E402
 from generator.case_spec import load_case_spec  # noqa: E402
@@ -63,14 +64,6 @@ KEYS = ("state", "gas_mass_balance_error", "bubble_length_over_a", "bubble_width
         "bubble_enclosed", "min_pressure_Pa", "wake_open", "inlet_meniscus_distance_over_a",
         "inlet_meniscus_shape", "oil_mass_balance_error", "end_reason", "steady",
         "simulated_time_s", "transit_time_s", "time_steps", "cells", "wall_s")
-
-
-def _cpu(case: Path) -> float | None:
-    logs = sorted(case.glob("log.*Foam"))
-    if not logs:
-        return None
-    times = re.findall(r"^ExecutionTime = ([0-9.eE+-]+) s", logs[0].read_text(errors="replace"), re.M)
-    return float(times[-1]) if times else None
 
 
 def _balances(case: Path) -> dict:
@@ -116,7 +109,7 @@ def one(job: tuple[str, Path, bool]) -> dict:
     m = json.loads(done.read_text())
     m.update(_last_transit(case))
     m.update(_balances(case))
-    return {"name": name, "overrides": RUNS[name], "cpu_s": _cpu(case),
+    return {"name": name, "overrides": RUNS[name], "cpu_s": solver_cpu_s(case),
             **{k: m.get(k) for k in KEYS},
             **{k: v for k, v in m.items() if k.endswith("_last_transit")}}
 

@@ -21,12 +21,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+
+from common import solver_cpu_s  # noqa: E402
 
 from foamlib import FoamFile  # noqa: E402
 
@@ -74,11 +75,6 @@ def _to_phase_change(case: Path, model: str, spec) -> None:
     atomic_write_json(geometry, g)
 
 
-def _cpu(log: Path) -> float | None:
-    times = re.findall(r"^ExecutionTime = ([0-9.eE+-]+) s", log.read_text(errors="replace"), re.M)
-    return float(times[-1]) if times else None
-
-
 def one(args, name: str) -> dict:
     work = Path(args.work)
     case = work / name
@@ -88,10 +84,9 @@ def one(args, name: str) -> dict:
     if name not in ("interFoam", "compressibleInterFoam"):
         _to_phase_change(case, name, spec)
     m = run_case(case, wall_limit=args.wall_limit)
-    log = next(case.glob("log.*Foam"))
     return {"candidate": name, "status": m["status"], "end_reason": m["end_reason"],
             "simulated_time_s": m["simulated_time_s"], "time_steps": m["time_steps"],
-            "cpu_s": _cpu(log), "oil_volume_m3": m["oil_volume_m3"],
+            "cpu_s": solver_cpu_s(case), "oil_volume_m3": m["oil_volume_m3"],
             "oil_volume_initial_m3": m["oil_volume_initial_m3"],
             "oil_carried_in_m3": m.get("oil_carried_in_m3"),
             "oil_carried_out_m3": m.get("oil_carried_out_m3"),

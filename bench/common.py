@@ -57,3 +57,16 @@ def save(name: str, data) -> Path:
 def log(msg: str) -> None:
     print(msg, flush=True)
     sys.stdout.flush()
+
+
+def solver_cpu_s(case: Path) -> float | None:
+    """The OpenFOAM solver's own last ``ExecutionTime`` [s] (CPU time) in the case's
+    ``log.*Foam``; None without a log or a reported time."""
+    import re
+
+    logs = sorted(Path(case).glob("log.*Foam"))
+    if not logs:
+        return None
+    text = logs[0].read_text(errors="replace")
+    times = re.findall(r"^ExecutionTime = ([0-9.eE+-]+) s", text, re.M)
+    return float(times[-1]) if times else None
