@@ -7,8 +7,9 @@ which it would not form from the standard start (hysteresis).
 Consecutive speeds at one load share the base mesh: the Hertzian radius a, hence the domain and
 the in-plane cells, depend on the load only, and the gap heights differ by nanometres. Then the
 final internal fields are copied cell by cell (exact, the equivalent of mapFields on an
-identical mesh). If the meshes differ (other cell count or in-plane positions), OpenFOAM's
-``mapFields -consistent`` interpolates them instead. Either way only the internal fields are
+identical mesh). If the meshes differ (other cell count or in-plane positions), they are
+interpolated layer by layer across the gap (:mod:`.field_mapping`; OpenFOAM's mapFields crashes
+on these meshes). Either way only the internal fields are
 taken over: the boundary conditions stay those of the new case (walls at the new speed).
 
 The seeded fields are written into the new case's ``0.orig/`` (its initial condition, copied
@@ -30,7 +31,7 @@ from ehl_precalc.outputs import atomic_write_json
 from generator.case_writer import META, load_geometry
 
 from .case_fields import time_folders
-from .foam_runtime import FoamRuntime
+from .field_mapping import LayeredMesh, interpolate
 
 #: The fields a ramp step takes over (internal values only) when its 0.orig/ has them:
 #: alpha.oil, U, p_rgh (interFoam), also p and T (compressibleInterFoam).
@@ -84,20 +85,17 @@ def _copied_fields(folder: Path, names: list[str]) -> dict[str, Any]:
     return {name: _read_internal(folder / name) for name in names}
 
 
-def _mapped_fields(case: Path, previous: Path, time_name: str, names: list[str],
-                   runtime: FoamRuntime) -> dict[str, Any]:
-    """Internal fields interpolated by ``mapFields -consistent`` onto the new mesh (in a
-    scratch ``0/`` that is removed afterwards)."""
-    zero = case / "0"
-    if zero.exists():
-        shutil.rmtree(zero)
-    shutil.copytree(case / "0.orig", zero)
-    try:
-        runtime.run("mapFields", [str(previous), "-consistent", "-sourceTime", time_name],
-                    cwd=case, log_path=case / "log.mapFields")
-        return {name: _read_internal(zero / name) for name in names}
-    finally:
-        shutil.rmtree(zero, ignore_errors=True)
+def _mapped_fields(case: Path, previous: Path, folder: Path, names: list[str]) -> dict[str, Any]:
+    """Internal fields interpolated onto the new mesh layer by layer (:mod:`.field_mapping`);
+    a uniform field is taken over as it is."""
+    source, target = LayeredMesh.load(previous), LayeredMesh.load(case)
+    out = {}
+    for name in names:
+        value = _read_internal(folder / name)
+        arr = np.asarray(value, dtype=float)
+        uniform = arr.ndim == 0 or (arr.ndim == 1 and len(arr) != len(source.base_cell))
+        out[name] = value if uniform else interpolate(arr, source, target)
+    return out
 
 
 def _write_internal(path: Path, value: Any) -> None:
@@ -109,11 +107,10 @@ def _write_internal(path: Path, value: Any) -> None:
         f.internal_field = value
 
 
-def seed_from_previous(case: str | Path, previous: str | Path,
-                       runtime: FoamRuntime | None = None) -> dict[str, Any]:
+def seed_from_previous(case: str | Path, previous: str | Path) -> dict[str, Any]:
     """Write ``previous``'s final internal fields (alpha.oil, U, p_rgh; p and T too in a
     compressible scene) as the initial fields of ``case`` (its ``0.orig/``), by copy on the
-    same mesh, else by mapFields.
+    same mesh, else interpolated layer by layer (:mod:`.field_mapping`).
 
     Returns (and writes to ``case/ehlfoam/ramp.json``) {"previous" (relative to the case),
     "previous_time_s", "method", "fields", "cells"}.
@@ -124,9 +121,7 @@ def seed_from_previous(case: str | Path, previous: str | Path,
     if same_mesh(case, previous):
         fields, method = _copied_fields(folder, names), "copy"
     else:
-        runtime = runtime or FoamRuntime.from_environment()
-        fields = _mapped_fields(case, previous, folder.name, names, runtime)
-        method = "mapFields"
+        fields, method = _mapped_fields(case, previous, folder, names), "interpolated"
     for name, value in fields.items():
         _write_internal(case / "0.orig" / name, value)
     if (case / "0").exists():      # a stale start folder would shadow 0.orig

@@ -1,0 +1,66 @@
+"""Interpolation of cell values between two generated layered meshes (runs/field_mapping.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial import Delaunay
+
+from generator.case_spec import make_case_spec
+from generator.case_writer import load_geometry, write_case
+from runs.field_mapping import LayeredMesh, interpolate
+from tiny import SMALL
+
+
+@pytest.fixture(scope="module")
+def meshes(tmp_path_factory):
+    """The tiny case's mesh (3 layers) and a finer one (smaller cells, 5 layers)."""
+    root = tmp_path_factory.mktemp("mapping")
+    coarse, fine = root / "coarse", root / "fine"
+    write_case(make_case_spec(SMALL), coarse)
+    write_case(make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "size_rim": 0.18,
+                                                 "n_layers": 5}}), fine)
+    return coarse, fine
+
+
+def test_relative_heights_span_the_gap(meshes):
+    m = LayeredMesh.load(meshes[1])
+    assert m.shape[1] == 5
+    assert np.all((m.zeta > 0) & (m.zeta < 1))
+    z = m.layer_zeta()
+    assert np.all(np.diff(z) > 0) and z[0] < 0.2 and z[-1] > 0.8
+    # graded symmetrically toward both walls
+    assert z[0] == pytest.approx(1 - z[-1], abs=1e-3)
+
+
+def test_a_linear_field_is_carried_over_exactly_inside_the_source(meshes):
+    src, dst = (LayeredMesh.load(c) for c in meshes)
+    a = load_geometry(meshes[0]).a
+
+    def field(m: LayeredMesh) -> np.ndarray:
+        xy = m.base_xy[m.base_cell] / a
+        return 1.0 + xy[:, 0] - 2.0 * xy[:, 1] + 0.5 * m.zeta
+
+    got = interpolate(field(src), src, dst)
+    want = field(dst)
+    # exact where the target cell lies between source layer centres across the gap and
+    # inside the hull of the source columns in plane (outside: nearest column)
+    z_s = src.layer_zeta()
+    inner = (dst.zeta >= z_s[0]) & (dst.zeta <= z_s[-1])
+    in_hull = Delaunay(src.base_xy).find_simplex(dst.base_xy[dst.base_cell]) >= 0
+    interior = inner & in_hull
+    assert interior.sum() > 0.5 * len(dst.zeta)
+    np.testing.assert_allclose(got[interior], want[interior], atol=1e-9)
+    # vectors: component by component
+    vec = np.stack([field(src), 2 * field(src), np.zeros(len(src.zeta))], axis=1)
+    got_vec = interpolate(vec, src, dst)
+    assert got_vec.shape == (len(dst.zeta), 3)
+    np.testing.assert_allclose(got_vec[interior, 1], 2 * want[interior], atol=1e-9)
+
+
+def test_values_stay_within_the_source_range(meshes):
+    src, dst = (LayeredMesh.load(c) for c in meshes)
+    rng = np.random.default_rng(1)
+    alpha = (rng.random(len(src.zeta)) > 0.5).astype(float)
+    got = interpolate(alpha, src, dst)
+    assert got.min() >= 0.0 and got.max() <= 1.0
