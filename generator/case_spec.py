@@ -66,6 +66,11 @@ class Supply(BaseModel):
         disc_layer, ball_layer: oil layer thickness on the disc and on the ball at the
             inlet [m] ("layers" mode).
         track_half_width: half-width of the oil track at the inlet [m].
+        track_inner_half_width: half-width of a dry band in the middle of the track [m]
+            (0: oil across the whole track). With it the oil arrives as two side bands,
+            |y| in [track_inner_half_width, track_half_width]: the two oil tracks a contact in
+            state II leaves behind, which come back to the inlet after a revolution when no
+            oil is added (ball_on_disc.md).
         initial_puddle: radius of the oil puddle around the contact at t = 0, units of a
             (0: none).
         initial_bubble: radius of a gas seed at t = 0, units of a, centred on the
@@ -79,6 +84,7 @@ class Supply(BaseModel):
     disc_layer: float = Field(2e-6, ge=0.0, le=1e-3)
     ball_layer: float = Field(2e-6, ge=0.0, le=1e-3)
     track_half_width: float = Field(3e-4, gt=0.0, le=0.1)
+    track_inner_half_width: float = Field(0.0, ge=0.0, le=0.1)
     initial_puddle: float = Field(4.0, ge=0.0, le=100.0)
     initial_bubble: float = Field(0.0, ge=0.0, le=20.0)
 
@@ -363,6 +369,11 @@ def _check_supply_fits(spec: CaseSpec) -> None:
         raise SpecError(
             f"invalid case spec: supply.track_half_width = {spec.supply.track_half_width:g} m "
             f"must be smaller than the domain side {spec.domain.side:g} a = {side:g} m")
+    inner = spec.supply.track_inner_half_width
+    if inner >= spec.supply.track_half_width:
+        raise SpecError(
+            f"invalid case spec: supply.track_inner_half_width = {inner:g} m must be in "
+            f"[0, {spec.supply.track_half_width:g}) m (below supply.track_half_width)")
     if not math.isfinite(spec.a):
         raise SpecError("invalid case spec: contact gives a non-finite Hertz radius")
 

@@ -158,7 +158,8 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     f = layer_fractions(level["n_layers"], level["wall_grading"])
     h = gap(x, y)
     k = mesh.layer
-    on_track = np.abs(y) < spec.supply.track_half_width
+    on_track = ((np.abs(y) < spec.supply.track_half_width)
+                & (np.abs(y) >= spec.supply.track_inner_half_width))
     alpha = oil_fraction(spec, h * f[k], h * f[k + 1], h, on_track)
     puddle = np.hypot(x, y) < spec.supply.initial_puddle * spec.a
     alpha = np.where(puddle, 1.0, alpha)
@@ -183,10 +184,12 @@ def supply_fraction(spec: CaseSpec, mesh: PolyMesh, patch: str = "inlet") -> np.
     _, inverse = np.unique(key, return_inverse=True)
     column = np.zeros(inverse.max() + 1)
     np.maximum.at(column, inverse, z_hi)
-    # the part of each face's width on the track, so that the supply's width is exact
-    w = spec.supply.track_half_width
+    # the part of each face's width on the track (less its dry middle band, if any), so that
+    # the supply's width is exact
+    w, w_in = spec.supply.track_half_width, spec.supply.track_inner_half_width
     y_lo, y_hi = mesh.points[faces, 1].min(axis=1), mesh.points[faces, 1].max(axis=1)
-    on_track = _overlap(y_lo, y_hi, -w, w) / np.maximum(y_hi - y_lo, 1e-300)
+    on_track = ((_overlap(y_lo, y_hi, -w, w) - _overlap(y_lo, y_hi, -w_in, w_in))
+                / np.maximum(y_hi - y_lo, 1e-300))
     return oil_fraction(spec, z_lo, z_hi, column[inverse], on_track)
 
 

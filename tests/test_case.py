@@ -70,6 +70,9 @@ def test_spec_defaults_are_the_reference_case():
     assert spec.oil_viscosity == pytest.approx(21.6e-3)
     with pytest.raises(SpecError, match="track_half_width"):
         make_case_spec({"supply": {"track_half_width": 0.01}})
+    with pytest.raises(SpecError, match=r"supply.track_inner_half_width = 0.0003 m must be in "
+                                        r"\[0, 0.0003\) m"):
+        make_case_spec({"supply": {"track_half_width": 3e-4, "track_inner_half_width": 3e-4}})
 
 
 def test_existing_case_is_not_overwritten(small_case):
@@ -159,6 +162,37 @@ def test_supply_carries_the_layers_in(small_case, tmp_path):
     s = case_fields.sample(case / "0.0002", case_fields.Structure.load(case), geom)
     expected = 0.02 * (3e-6 + 3e-6) * 2 * 2.5e-4
     assert s.oil_in == pytest.approx(expected, rel=0.05)
+
+
+def test_side_bands_carry_their_layers_in(tmp_path):
+    """With a dry middle band the oil enters only on |y| in [inner, outer]: the flux is
+    u x (disc + ball layer) x 2 (outer - inner), and no supply face lies inside the band."""
+    from foamlib import FoamFieldFile
+
+    from runs import case_fields
+
+    inner = 1.0e-4
+    case = tmp_path / "bands"
+    write_case(make_case_spec({**SMALL, "supply": {**SMALL["supply"],
+                                                   "track_inner_half_width": inner}}), case)
+    d = np.load(case / "ehlfoam" / "mesh.npz")
+    k = list(d["patch_names"]).index("supply")
+    start, size = d["patch_starts"][k], d["patch_sizes"][k]
+    y = d["face_centres_boundary"][start:start + size, 1]
+    assert np.all(np.abs(y) > inner - 0.5 * 1.2 * 1.4e-4)   # outside the band (- half a face)
+    alpha0 = np.asarray(FoamFieldFile(case / "0.orig" / "alpha.oil").internal_field)
+    yc, xc = d["cell_centres"][:, 1], d["cell_centres"][:, 0]
+    a = load_geometry(case).a
+    upstream = xc < -SMALL["supply"]["initial_puddle"] * a   # outside the initial puddle
+    assert alpha0[upstream & (np.abs(yc) < 0.9 * inner)].max() == 0.0
+    assert alpha0[upstream & (np.abs(yc) > 1.1 * inner) & (np.abs(yc) < 2.4e-4)].max() > 0
+    with FoamFile(case / "system" / "controlDict") as f:
+        f["endTime"] = 2e-4
+        f["writeInterval"] = 1e-4
+    shutil.copytree(case / "0.orig", case / "0")
+    FoamRuntime.from_environment().run("interFoam", [], cwd=case)
+    s = case_fields.sample(case / "0.0002", case_fields.Structure.load(case), load_geometry(case))
+    assert s.oil_in == pytest.approx(0.02 * (3e-6 + 3e-6) * 2 * (2.5e-4 - inner), rel=0.05)
 
 
 def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
