@@ -6,7 +6,9 @@ the meniscus on y = 0, against the resolution, the interface compression cAlpha 
 step (the capillary limit), as ratios to the nominal rolling speed. Writes
 ``bench/results/static_meniscus.json``.
 
-    python bench/static_meniscus.py [--speed 0.008] [--time 0.02]
+    python bench/static_meniscus.py [--speed 0.008] [--time 0.02] [--levels coarse medium]
+        [--compression 0 1] [--safety 1 0.25] [--air-viscosity 1.8e-5]
+        [--nhat default pointCellsLeastSquares] [--tag NAME]
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from foamlib import FoamFieldFile  # noqa: E402
+from foamlib import FoamFieldFile, FoamFile  # noqa: E402
 
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import write_case  # noqa: E402
@@ -54,10 +56,14 @@ def main(argv=None) -> int:
     ap.add_argument("--air-viscosity", nargs="+", type=float, default=[1.8e-5],
                     help="air viscosities [Pa s] (the reference assumes 1.8e-5)")
     ap.add_argument("--work", default=str(ROOT / "runs" / "checks" / "static_meniscus"))
+    ap.add_argument("--nhat", nargs="+", default=["default"],
+                    help="gradient schemes for the interface normal (fvSchemes gradSchemes "
+                         "nHat; 'default' keeps the template's Gauss linear)")
+    ap.add_argument("--tag", default="", help="results go to static_meniscus[_TAG].json")
     args = ap.parse_args(argv)
     rows = []
-    for level, c_alpha, safety, mu_air in itertools.product(
-            args.levels, args.compression, args.safety, args.air_viscosity):
+    for level, c_alpha, safety, mu_air, nhat in itertools.product(
+            args.levels, args.compression, args.safety, args.air_viscosity, args.nhat):
         spec = make_case_spec({
             "name": "static", "walls_moving": False, "contact": {"speed": args.speed},
             "mesh": {"resolution": level},
@@ -66,11 +72,16 @@ def main(argv=None) -> int:
             "physics": {"interface_compression": c_alpha, "air_viscosity": mu_air},
             "run": {"end_time": args.time, "capillary_safety": safety,
                     "writes_per_transit": 200}})
-        case = Path(args.work) / f"{level}_c{c_alpha:g}_s{safety:g}_air{mu_air:g}"
+        name = f"{level}_c{c_alpha:g}_s{safety:g}_air{mu_air:g}_t{args.time:g}"
+        case = Path(args.work) / (name if nhat == "default" else f"{name}_{nhat.replace(' ', '')}")
         geom = write_case(spec, case, overwrite=True)
+        if nhat != "default":
+            with FoamFile(case / "system" / "fvSchemes") as f:
+                words = tuple(nhat.split())
+                f["gradSchemes"]["nHat"] = words if len(words) > 1 else nhat
         m = run_case(case)
         s = spurious(case)
-        row = {"level": level, "cAlpha": c_alpha, "capillary_safety": safety,
+        row = {"level": level, "cAlpha": c_alpha, "capillary_safety": safety, "nHat": nhat,
                "air_viscosity": mu_air,
                "air_viscosity_in_solver": mu_air * spec.run.air_viscosity_factor,
                "max_delta_t_s": geom.max_delta_t, "cells": geom.cells,
@@ -83,7 +94,8 @@ def main(argv=None) -> int:
         print(json.dumps(row), flush=True)
         rows.append(row)
     RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "static_meniscus.json").write_text(
+    name = f"static_meniscus_{args.tag}.json" if args.tag else "static_meniscus.json"
+    (RESULTS / name).write_text(
         json.dumps({"args": vars(args), "rows": rows}, indent=2) + "\n")
     return 0
 
