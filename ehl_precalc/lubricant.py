@@ -89,8 +89,9 @@ class PressureLaws:
     density: str = "dowson-higginson"
     twophase_p_scale: float | None = None
 
-    def eta(self, P: np.ndarray) -> np.ndarray:
-        """eta / eta0 at dimensionless pressure P (sub-ambient pressures use eta0)."""
+    def ln_eta(self, P: np.ndarray) -> np.ndarray:
+        """ln(eta / eta0) at dimensionless pressure P, capped at :data:`ETA_LN_CAP`
+        (sub-ambient pressures use eta0)."""
         p = np.maximum(P, 0.0) * self.p_hertz
         lub = self.lubricant
         if self.viscosity == "barus":
@@ -100,7 +101,26 @@ class PressureLaws:
             ln_eta = a * ((1.0 + p / ROELANDS_P0_PA) ** lub.roelands_z - 1.0)
         # beyond e^300 the Poiseuille term is zero to machine precision anyway; the cap keeps
         # an intermediate pressure overshoot from turning into inf * 0 = nan
-        return np.exp(np.minimum(ln_eta, ETA_LN_CAP))
+        return np.minimum(ln_eta, ETA_LN_CAP)
+
+    def eta(self, P: np.ndarray) -> np.ndarray:
+        """eta / eta0 at dimensionless pressure P (sub-ambient pressures use eta0)."""
+        return np.exp(self.ln_eta(P))
+
+    def dln_eta_dP(self, P: np.ndarray) -> np.ndarray:
+        """d ln(eta / eta0) / dP at dimensionless pressure P (0 below ambient and beyond the
+        cap :data:`ETA_LN_CAP`)."""
+        p = np.maximum(P, 0.0) * self.p_hertz
+        lub = self.lubricant
+        if self.viscosity == "barus":
+            ln_eta = lub.alpha * p
+            slope = np.full_like(p, lub.alpha * self.p_hertz)
+        else:
+            a = np.log(lub.eta0) - ROELANDS_LN_ETA_INF
+            z = lub.roelands_z
+            ln_eta = a * ((1.0 + p / ROELANDS_P0_PA) ** z - 1.0)
+            slope = a * z * (1.0 + p / ROELANDS_P0_PA) ** (z - 1.0) * self.p_hertz / ROELANDS_P0_PA
+        return np.where((P > 0.0) & (ln_eta < ETA_LN_CAP), slope, 0.0)
 
     def rho(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(rho / rho0, d(rho/rho0)/dP) at dimensionless pressure P."""

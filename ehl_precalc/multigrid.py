@@ -51,6 +51,8 @@ class SolverOptions:
 
     tol_residual: relative Reynolds residual sum|r| / sum|d(rho H)/dX| to reach.
     tol_load: relative load-balance error to reach.
+    max_ln_eta_step: largest change of ln(eta / eta0) one relaxation sweep may make at a
+        point (see :func:`limit_viscosity_step`); 0 switches the limiter off.
     """
 
     nu1: int = 2
@@ -67,6 +69,7 @@ class SolverOptions:
     max_cycles: int = 60
     tol_residual: float = 3e-5
     tol_load: float = 3e-5
+    max_ln_eta_step: float = 2.0
 
 
 @dataclass
@@ -126,8 +129,34 @@ class Level:
 
     def relax(self, H0: float, prob: Problem, opt: SolverOptions) -> None:
         H, rho, drho, eps = self.coefficients(self.P, H0, prob)
+        P_old = self.P.copy() if opt.max_ln_eta_step > 0.0 else None
+        deps = -eps * prob.laws.dln_eta_dP(self.P)
         relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
-              opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet, self.work)
+              opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet, self.work,
+              deps)
+        if P_old is not None:
+            limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step)
+            if prob.neumann_outlet:
+                self.P[:, -1] = self.P[:, -2]
+
+
+def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
+                         max_step: float) -> None:
+    """Damp a relaxation sweep where it would change the viscosity by more than a factor
+    e^max_step; updates the dimensionless pressure ``P`` in place.
+
+    The line systems hold eps = rho H^3 / (eta lambda) frozen, so where the pressure-viscosity
+    product alpha pH is large (Moes L >= 20) a step of a few tenths in P changes eta by orders
+    of magnitude and the next sweep overshoots: the pressure spike runs away to
+    exp(alpha p) overflow. Scaling the step at such points to |d ln(eta)| = max_step keeps the
+    fixed point (the limiter is inactive once the steps are small) and only slows the first
+    sweeps of a large-L solve.
+    """
+    dP = P - P_old
+    d_ln_eta = np.abs(laws.ln_eta(P) - laws.ln_eta(P_old))
+    big = d_ln_eta > max_step
+    if np.any(big):
+        P[big] = P_old[big] + dP[big] * (max_step / d_ln_eta[big])
 
 
 def _restrict_full_weighting(r: np.ndarray) -> np.ndarray:

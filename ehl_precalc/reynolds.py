@@ -92,7 +92,7 @@ def _penta_solve(a, b, c, d, e, rhs, x):
 
 @njit(cache=True)
 def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, p_floor, neumann_out, D,
-          point_ja=True):
+          deps, point_ja=True):
     """One X-line relaxation sweep; updates P in place.
 
     Args:
@@ -106,6 +106,10 @@ def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, p_floor, 
             the classic p >= 0 condition, absolute zero for the two-phase model).
         neumann_out: zero-gradient outlet (P[:, -1] = P[:, -2]) instead of P = 0.
         D: work array (Jacobi changes).
+        deps: d(eps)/dP through the viscosity (-eps d ln(eta)/dP). At Gauss-Seidel points
+            its Poiseuille contribution enters the diagonal where it strengthens it (just
+            behind the pressure spike, where the pressure falls steeply and eps grows by
+            orders of magnitude within a cell, the frozen-eps Newton step overshoots).
     Returns:
         The number of distributive-Jacobi points in the sweep.
     """
@@ -168,6 +172,13 @@ def relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, p_floor, 
                 if gs[mc]:
                     if off == 0:
                         v += diag
+                        # viscosity derivative of the own eps in the face coefficients
+                        p0 = P[j, i]
+                        lap = 0.5 * deps[j, i] * (
+                            (P[j, i - 1] + P[j, i + 1] - 2.0 * p0) / hx2
+                            + (P[j - 1, i] + P[j + 1, i] - 2.0 * p0) / hy2)
+                        if lap < 0.0:
+                            v += lap
                     elif off == -1:
                         v += exm
                     elif off == 1:

@@ -110,6 +110,46 @@ def test_classic_moderate_case_matches_nvm():
     assert 0 < s["hmin_m"] < s["hc_m"]
 
 
+def test_high_pressure_viscosity_light_load_converges():
+    """M = 10, L = 20 (alpha pH ~ 16, sharp pressure spike): the frozen-viscosity line steps
+    used to overshoot at the spike until exp(alpha p) overflowed (NaN at cycle 4-6)."""
+    c = contact_from_moes(10, 20)
+    spec = make_spec(load=c.load, speed=c.speed, lubricant="custom", eta0=c.eta0,
+                     alpha=c.alpha, rho0=870.0, radius=c.radius, modulus=c.modulus,
+                     viscosity="barus", density="incompressible", grid=129)
+    r = solve(spec)
+    s = r.summary()
+    assert r.converged, s["failure"]
+    assert np.all(np.isfinite(r.mg.P))
+    assert s["residual"] < 3e-5 and s["load_error"] < 3e-5
+    assert s["hc_m"] == pytest.approx(s["hc_nvm_m"], rel=0.1)
+    assert 0 < s["hmin_m"] < s["hc_m"]
+
+
+def test_viscosity_slope_matches_finite_difference():
+    from ehl_precalc.spec import make_spec as ms
+
+    for law in ("barus", "roelands"):
+        laws = ms(load=20, speed=0.01, temperature=40, viscosity=law).laws()
+        P = np.array([0.0, 0.3, 1.0, 2.0])
+        d = 1e-6
+        fd = (np.log(laws.eta(P + d)) - np.log(laws.eta(P))) / d
+        assert np.allclose(laws.dln_eta_dP(P + d / 2), fd, rtol=1e-4)
+        assert laws.dln_eta_dP(np.array([-0.1]))[0] == 0.0
+
+
+def test_viscosity_step_limiter_scales_large_steps_only():
+    from ehl_precalc.multigrid import limit_viscosity_step
+
+    laws = make_spec(load=20, speed=0.01, temperature=40, viscosity="barus").laws()
+    slope = laws.dln_eta_dP(np.array([1.0]))[0]
+    P_old = np.array([1.0, 1.0])
+    P = P_old + np.array([1e-3, 10.0 / slope])  # d ln(eta) = small, 10
+    limit_viscosity_step(P_old, P, laws, 2.0)
+    assert P[0] == 1.0 + 1e-3
+    assert (P[1] - 1.0) * slope == pytest.approx(2.0, rel=1e-9)
+
+
 def test_non_converging_run_is_reported():
     r = solve(make_spec(load=20, speed=0.01, temperature=40, grid=65, max_cycles=1))
     s = r.summary()
