@@ -3,8 +3,12 @@ state per resolution level, with the flow-pattern metrics each level gives.
 
     python bench/case_bench.py [--levels coarse medium fine] [--speed 0.008]
         [--supply layers --layer 2e-6 --track 3e-4] [--jobs 2] [--wall-limit 3600]
+        [--sequence] [--procs N] [--collect]
 
-Each level runs serially (one core); ``--jobs`` runs levels side by side. Writes
+Each level runs serially (one core; ``--procs`` ranks with mpirun); ``--jobs`` runs levels side
+by side. ``--sequence`` runs the levels one after the other, each starting from the previous
+level's final fields (interpolated onto its mesh, runs/field_mapping.py): grid sequencing, the
+way to reach a fine level's steady state without paying for its whole transient. Writes
 ``bench/results/case_bench_<tag>.json`` and prints a table. The metrics' change from level to
 level is the mesh-convergence figure of the inlet meniscus distance and the flooded width.
 """
@@ -22,31 +26,45 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from generator.case_spec import make_case_spec  # noqa: E402
-from generator.case_writer import write_case  # noqa: E402
+from generator.case_writer import load_geometry, write_case  # noqa: E402
+from common import solver_cpu_s  # noqa: E402
+from runs.ramp import seed_from_previous  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
 RESULTS = ROOT / "bench" / "results"
 KEYS = ("state", "inlet_meniscus_distance_over_a", "inlet_meniscus_shape",
         "flooded_length_over_a", "flooded_width_over_a", "wake_gas_length_over_a",
         "oil_volume_m3", "oil_mass_balance_error", "steady", "end_reason", "cells",
-        "time_steps", "simulated_time_s", "wall_s", "wall_s_per_simulated_ms")
+        "time_steps", "simulated_time_s", "wall_s", "wall_s_per_simulated_ms",
+        "ramp_start_method")
 
 
-def one(level: str, args: argparse.Namespace) -> dict:
+def one(level: str, args: argparse.Namespace, previous: str | None = None) -> dict:
+    """Build and run ``level``; started from the final fields of the level ``previous`` (a
+    sibling case) when given."""
     spec = make_case_spec({
         "name": f"bench-{level}", "contact": {"speed": args.speed},
         "mesh": {"resolution": level},
         "supply": {"mode": args.supply, "disc_layer": args.layer, "ball_layer": args.layer,
                    "track_half_width": args.track},
-        "run": {"wall_limit": args.wall_limit, "transits_max": args.transits}})
+        "run": {"wall_limit": args.wall_limit, "transits_max": args.transits,
+                "n_procs": args.procs}})
     case = Path(args.work) / args.tag / level
     t0 = time.perf_counter()
-    geom = write_case(spec, case, overwrite=True)
+    write_case(spec, case, overwrite=True)
+    if previous is not None:
+        seed_from_previous(case, case.parent / previous)
     build_s = time.perf_counter() - t0
-    m = run_case(case)
-    row = {"level": level, "build_s": build_s, "max_delta_t_s": geom.max_delta_t,
-           **{k: m.get(k) for k in KEYS}}
-    return row
+    run_case(case)
+    return row_of(case, level, previous, build_s)
+
+
+def row_of(case: Path, level: str, previous: str | None, build_s: float | None = None) -> dict:
+    """The table row of a run case (its metrics.json and the solver's CPU time)."""
+    m = json.loads((case / "metrics.json").read_text())
+    return {"level": level, "started_from": previous, "build_s": build_s,
+            "max_delta_t_s": load_geometry(case).max_delta_t, "solver_cpu_s": solver_cpu_s(case),
+            **{k: m.get(k) for k in KEYS}}
 
 
 def main(argv=None) -> int:
@@ -60,14 +78,29 @@ def main(argv=None) -> int:
     ap.add_argument("--wall-limit", type=float, default=3600.0)
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--tag", default="nominal")
+    ap.add_argument("--sequence", action="store_true",
+                    help="each level starts from the previous level's final fields")
+    ap.add_argument("--procs", type=int, default=1, help="MPI ranks per case")
+    ap.add_argument("--collect", action="store_true",
+                    help="only tabulate the levels already run under --tag")
     ap.add_argument("--work", default=str(ROOT / "runs" / "bench"))
     args = ap.parse_args(argv)
-    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
-        rows = list(pool.map(one, args.levels, [args] * len(args.levels)))
+    previous = {level: (args.levels[i - 1] if i and args.sequence else None)
+                for i, level in enumerate(args.levels)}
+    if args.collect:
+        rows = [row_of(Path(args.work) / args.tag / level, level, previous[level])
+                for level in args.levels
+                if (Path(args.work) / args.tag / level / "metrics.json").is_file()]
+    elif args.sequence:
+        rows = [one(level, args, previous[level]) for level in args.levels]
+    else:
+        with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+            rows = list(pool.map(one, args.levels, [args] * len(args.levels)))
     RESULTS.mkdir(parents=True, exist_ok=True)
     out = RESULTS / f"case_bench_{args.tag}.json"
     out.write_text(json.dumps({"args": vars(args), "rows": rows}, indent=2) + "\n")
-    head = ("level", "cells", "time_steps", "simulated_time_s", "wall_s", "end_reason", "state",
+    head = ("level", "started_from", "cells", "time_steps", "simulated_time_s", "solver_cpu_s",
+            "wall_s", "end_reason", "state",
             "inlet_meniscus_distance_over_a", "flooded_width_over_a", "flooded_length_over_a")
     print(" | ".join(head))
     for r in rows:

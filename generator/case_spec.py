@@ -48,11 +48,15 @@ from ehl_precalc.spec import PrecalcSpec, SpecError, range_text, read_toml
 
 _STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
-#: In-plane cell size at the island rim and far away (units a), and cells across the gap.
+#: In-plane cell size at the island rim and far away (units a), cells across the gap and their
+#: grading toward the walls. The wall cell is 2.4 / 1.7 / 1.2 % of the local gap: the oil films
+#: left behind the flooded region are a few per cent of the gap, and with wall cells of 8 % (the
+#: levels before, 6 layers graded 3) they were not resolved, too little oil left the flooded
+#: region and no run became steady (docs/cases.md, "Mesh levels").
 RESOLUTIONS: dict[str, dict[str, float]] = {
-    "coarse": {"size_rim": 0.12, "size_far": 0.8, "n_layers": 6, "wall_grading": 3.0},
-    "medium": {"size_rim": 0.08, "size_far": 0.55, "n_layers": 8, "wall_grading": 4.0},
-    "fine": {"size_rim": 0.055, "size_far": 0.38, "n_layers": 10, "wall_grading": 5.0},
+    "coarse": {"size_rim": 0.12, "size_far": 0.8, "n_layers": 10, "wall_grading": 8.0},
+    "medium": {"size_rim": 0.08, "size_far": 0.55, "n_layers": 12, "wall_grading": 10.0},
+    "fine": {"size_rim": 0.055, "size_far": 0.38, "n_layers": 14, "wall_grading": 12.0},
 }
 
 

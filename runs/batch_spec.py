@@ -59,9 +59,9 @@ PARAM_KEYS = ("speed_mm_s", "temperature_C", "load_N", "supply", "disc_layer_um"
               "ball_layer_um", "resolution")
 
 #: Rough cost model for ordering (longest first) and the first ETA: CPU seconds per simulated
-#: millisecond per resolution level (docs/cases.md, "Cost per level", nominal case), plus a
+#: millisecond per resolution level (docs/cases.md, "The re-levelled meshes", 8 mm/s), plus a
 #: fixed build cost and the EHL precalc of a new contact.
-CPU_PER_SIMULATED_MS = {"coarse": 0.28, "medium": 1.26, "fine": 5.1}
+CPU_PER_SIMULATED_MS = {"coarse": 0.50, "medium": 2.5, "fine": 10.1}
 BUILD_CPU_S = 5.0
 PRECALC_CPU_S = 60.0
 
