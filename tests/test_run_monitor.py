@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from runs.case_fields import Sample
-from runs.run_case import _steady, mass_balance
+from runs.run_case import _steady, mass_balance, steady_test
 
 
 def history(volumes, menisci, dt=0.01, state="I"):
@@ -38,6 +38,35 @@ def test_not_steady_when_the_state_flips():
     h = history([1.0] * 12, [3.0] * 12)
     h[-1].pattern["state"] = "II"
     assert not _steady(h, window=0.1, tol=0.01, length_scale=10.0)
+
+
+def fluctuating(n, volume_drift=0.0):
+    """A flooded region whose width jumps between 6.5, 5.75 and 5.75 a from write to write
+    (its fingers; mean 6 a), the oil volume drifting by volume_drift per write."""
+    h = history([1.0 + volume_drift * k for k in range(n)], [3.0] * n)
+    for k, s in enumerate(h):
+        s.pattern["flooded_width_over_a"] = 6.0 + (0.5 if k % 3 == 0 else -0.25)
+    return h
+
+
+def test_a_fluctuating_flow_is_steady_in_the_mean():
+    # the last write differs by 0.75 a from the one a transit (10 writes) earlier
+    h = fluctuating(22)
+    assert steady_test(h[:11], window=0.1, tol=0.01, length_scale=10.0) is None  # < 2 windows
+    assert steady_test(h, window=0.1, tol=0.01, length_scale=10.0) == "window mean"
+    assert steady_test(history([1.0] * 12, [3.0] * 12), window=0.1, tol=0.01,
+                       length_scale=10.0) == "last write"
+
+
+@pytest.mark.parametrize("change", ["volume", "state", "width"])
+def test_not_steady_in_the_mean_while_the_mean_moves(change):
+    h = fluctuating(22, volume_drift=0.004 if change == "volume" else 0.0)
+    if change == "state":
+        h[-3].pattern["state"] = "II"
+    if change == "width":       # the mean width grows by 0.2 a per transit
+        for k, s in enumerate(h):
+            s.pattern["flooded_width_over_a"] += 0.02 * k
+    assert steady_test(h, window=0.1, tol=0.01, length_scale=10.0) is None
 
 
 def test_mass_balance_closes_for_a_consistent_history():
