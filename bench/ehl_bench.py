@@ -1,12 +1,15 @@
 """Cost and accuracy of the EHL solver against grid size (nominal case: 20 N, 10 mm/s, 40 C).
 
     .venv/bin/python bench/ehl_bench.py [--max 2049] [--memory-only 4097]
+    .venv/bin/python bench/ehl_bench.py --full 4097
 
 For N = 129 .. --max points a side: wall time (numba compiled beforehand), cycles, peak
 memory of the process, hc; the observed order of convergence and the Richardson
 extrapolation from the three finest grids; hc error of each grid against that estimate; the
 cost ratio per grid doubling. ``--memory-only N`` also runs one grid of N points a side and
-reports its peak memory over three cycles (the thesis's scale is 4097). Writes
+reports its peak memory over three cycles (the thesis's scale is 4097). ``--full N`` solves
+only that grid to convergence and writes ehl_bench_full_N.json (its wall time, cycles, peak
+memory and hc). Otherwise writes
 bench/results/ehl_bench.json and ehl_cost_vs_error.png (wall time against hc error).
 """
 
@@ -25,7 +28,18 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--max", type=int, default=2049)
     ap.add_argument("--memory-only", type=int, default=None)
+    ap.add_argument("--full", type=int, default=None, help="time one full solve on N points")
     args = ap.parse_args()
+    if args.full:
+        s = solve_in_subprocess({**NOMINAL, "grid": args.full})
+        row = dict(N=args.full, wall_s=s["wall_s"], cycles=s["cycles"], peak_GiB=s["peak_rss_GiB"],
+                   hc_nm=s["hc_m"] * 1e9, converged=s["converged"], residual=s.get("residual"),
+                   load_error=s.get("load_error"), ramp=bool(s["continuation_M"]),
+                   cores=os.cpu_count(), load_average=os.getloadavg())
+        log(f"N = {args.full}: {row['wall_s']:.0f} s, {row['cycles']} cycles, peak "
+            f"{row['peak_GiB']:.2f} GiB, hc = {row['hc_nm']:.4f} nm, converged={row['converged']}")
+        save(f"ehl_bench_full_{args.full}.json", {"case": NOMINAL, **row})
+        return
     grids = [n for n in (129, 257, 513, 1025, 2049, 4097) if n <= args.max]
     rows = []
     log(f"cores: {os.cpu_count()}")

@@ -1,13 +1,16 @@
 """Stability map of the EHL solver: converged / failed over Moes M and L.
 
-    .venv/bin/python bench/stability_map.py [--grid 257] [--jobs 2]
+    .venv/bin/python bench/stability_map.py [--grid 257|default] [--m-max 1000] [--jobs 2]
 
 Each point is an SI contact realising (M, L) (ehl_precalc.formulas.contact_from_moes, steel
 on steel) with Barus viscosity and an incompressible oil, the laws under which the problem
 depends on M and L only, solved from scratch on one grid. A point is 'converged' when the
 residual and load tolerances were met, 'stagnated' when the cycles stalled within ten times
 the tolerance, 'failed' otherwise (diverged or far from converged); it records hc / NVM and
-the reason. Writes bench/results/stability_map.{json,png}.
+the reason. Writes bench/results/stability_map.{json,png}; ``--grid default`` solves each point
+on the grid the solver picks by itself (ehl_precalc.solver.default_grid: 513^2 below M = 300,
+1025^2 from there) and writes stability_map_default.{json,png}; ``--m-max`` keeps the points
+with M up to that value (1000: the classic range).
 """
 
 from __future__ import annotations
@@ -24,7 +27,8 @@ M_VALUES = [10, 30, 100, 300, 1000, 3000, 10000, 30000]
 L_VALUES = [0, 2, 5, 10, 20]
 
 
-def point(M: float, L: float, grid: int) -> dict:
+def point(M: float, L: float, grid: int | None) -> dict:
+    """Solve one (M, L) point on ``grid`` points a side (None: the solver's default grid)."""
     c = contact_from_moes(M, L)
     spec = dict(load=c.load, speed=c.speed, radius=c.radius, modulus=c.modulus,
                 lubricant="custom", eta0=c.eta0, alpha=c.alpha, rho0=870.0, grid=grid,
@@ -34,7 +38,7 @@ def point(M: float, L: float, grid: int) -> dict:
     res = s.get("residual")
     status = ("converged" if s["converged"] else
               "stagnated" if res is not None and res < 10 * 3e-5 else "failed")
-    row = dict(M=M, L=L, status=status, converged=bool(s["converged"]), residual=res,
+    row = dict(M=M, L=L, grid=s.get("grid"), status=status, converged=bool(s["converged"]), residual=res,
                load_error=s.get("load_error"), cycles=s.get("cycles"), wall_s=s["wall_s"],
                hc_over_nvm=hc_ratio, hmin_positive=(s.get("hmin_m") or -1) > 0,
                failure=s.get("failure"), continuation=s.get("continuation_M"))
@@ -43,7 +47,7 @@ def point(M: float, L: float, grid: int) -> dict:
     return row
 
 
-def plot(rows: list[dict], grid: int) -> None:
+def plot(rows: list[dict], grid: int | str, name: str = "stability_map") -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -68,12 +72,13 @@ def plot(rows: list[dict], grid: int) -> None:
                  fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(RESULTS / "stability_map.png", dpi=120)
+    fig.savefig(RESULTS / f"{name}.png", dpi=120)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--grid", type=int, default=257)
+    ap.add_argument("--grid", default="257", help="points a side, or 'default'")
+    ap.add_argument("--m-max", type=float, default=max(M_VALUES))
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--replot", action="store_true", help="only redraw the saved map")
     args = ap.parse_args()
@@ -81,11 +86,13 @@ def main() -> None:
         data = json.loads((RESULTS / "stability_map.json").read_text())
         plot(data["points"], data["grid"])
         return
-    pts = [(M, L) for L in L_VALUES for M in M_VALUES]
+    grid = None if args.grid == "default" else int(args.grid)
+    name = "stability_map" if grid is not None else "stability_map_default"
+    pts = [(M, L) for L in L_VALUES for M in M_VALUES if M <= args.m_max]
     with ThreadPoolExecutor(args.jobs) as ex:
-        rows = list(ex.map(lambda ml: point(ml[0], ml[1], args.grid), pts))
-    save("stability_map.json", {"grid": args.grid, "points": rows})
-    plot(rows, args.grid)
+        rows = list(ex.map(lambda ml: point(ml[0], ml[1], grid), pts))
+    save(f"{name}.json", {"grid": args.grid, "points": rows})
+    plot(rows, args.grid, name)
     for st in ("converged", "stagnated", "failed"):
         log(f"{st}: {sum(r['status'] == st for r in rows)}/{len(rows)}")
     for r in rows:
