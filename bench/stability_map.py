@@ -98,7 +98,7 @@ def main() -> None:
     for r in rows:
         if r["status"] != "converged":
             log(f"  {r['status']} M={r['M']} L={r['L']}: {r['failure']}")
-    log(f"map in {RESULTS / 'stability_map.png'}")
+    log(f"map in {RESULTS / (name + '.png')}")
 
 
 if __name__ == "__main__":
