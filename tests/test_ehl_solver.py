@@ -94,14 +94,19 @@ def test_hc_increases_with_speed(series):
         assert 0.5 < exponent < 0.8  # Hamrock-Dowson: 0.67
 
 
+def _solve_moes(M: float, L: float, grid: int = 129):
+    """Solve the contact realising (M, L) with Barus viscosity and an incompressible oil (the
+    laws under which the problem depends on M and L only): (contact, result, summary)."""
+    c = contact_from_moes(M, L)
+    r = solve(make_spec(load=c.load, speed=c.speed, lubricant="custom", eta0=c.eta0,
+                        alpha=c.alpha, rho0=870.0, radius=c.radius, modulus=c.modulus,
+                        viscosity="barus", density="incompressible", grid=grid))
+    return c, r, r.summary()
+
+
 def test_classic_moderate_case_matches_nvm():
     """M = 20, L = 10, Barus, incompressible: the regime of the NVM regression (within 5 %)."""
-    c = contact_from_moes(20, 10)
-    spec = make_spec(load=c.load, speed=c.speed, lubricant="custom", eta0=c.eta0,
-                     alpha=c.alpha, rho0=870.0, radius=c.radius, modulus=c.modulus,
-                     viscosity="barus", density="incompressible", grid=129)
-    r = solve(spec)
-    s = r.summary()
+    c, r, s = _solve_moes(20, 10)
     assert r.converged
     assert s["M"] == pytest.approx(20, rel=1e-9) and s["L"] == pytest.approx(10, rel=1e-9)
     # the Hertz-scaled NVM film, H = H_M (3M/2)^(-2/3), times a^2/R
@@ -113,12 +118,7 @@ def test_classic_moderate_case_matches_nvm():
 def test_high_pressure_viscosity_light_load_converges():
     """M = 10, L = 20 (alpha pH ~ 16, sharp pressure spike): the frozen-viscosity line steps
     used to overshoot at the spike until exp(alpha p) overflowed (NaN at cycle 4-6)."""
-    c = contact_from_moes(10, 20)
-    spec = make_spec(load=c.load, speed=c.speed, lubricant="custom", eta0=c.eta0,
-                     alpha=c.alpha, rho0=870.0, radius=c.radius, modulus=c.modulus,
-                     viscosity="barus", density="incompressible", grid=129)
-    r = solve(spec)
-    s = r.summary()
+    _, r, s = _solve_moes(10, 20)
     assert r.converged, s["failure"]
     assert np.all(np.isfinite(r.mg.P))
     assert s["residual"] < 3e-5 and s["load_error"] < 3e-5
