@@ -113,14 +113,12 @@ class PressureLaws:
         p = np.maximum(P, 0.0) * self.p_hertz
         lub = self.lubricant
         if self.viscosity == "barus":
-            ln_eta = lub.alpha * p
             slope = np.full_like(p, lub.alpha * self.p_hertz)
         else:
             a = np.log(lub.eta0) - ROELANDS_LN_ETA_INF
             z = lub.roelands_z
-            ln_eta = a * ((1.0 + p / ROELANDS_P0_PA) ** z - 1.0)
             slope = a * z * (1.0 + p / ROELANDS_P0_PA) ** (z - 1.0) * self.p_hertz / ROELANDS_P0_PA
-        return np.where((P > 0.0) & (ln_eta < ETA_LN_CAP), slope, 0.0)
+        return np.where((P > 0.0) & (self.ln_eta(P) < ETA_LN_CAP), slope, 0.0)
 
     def rho(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(rho / rho0, d(rho/rho0)/dP) at dimensionless pressure P."""

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator
 
-from generator.case_writer import META
+from .case_fields import Structure
 
 
 @dataclass(frozen=True)
@@ -40,17 +40,13 @@ class LayeredMesh:
 
     @classmethod
     def load(cls, case: str | Path) -> "LayeredMesh":
-        d = np.load(Path(case) / META / "mesh.npz")
-        base, layer, vol = d["base_cell"], d["layer"], d["cell_volumes"]
-        n_base, n_layers = int(base.max()) + 1, int(layer.max()) + 1
-        v = np.zeros((n_base, n_layers))
-        v[base, layer] = vol
+        s = Structure.load(case)
+        base, layer = s.base_cell, s.layer
+        v = np.zeros((len(s.base_x), int(layer.max()) + 1))
+        v[base, layer] = s.cell_volumes
         below = np.cumsum(v, axis=1) - 0.5 * v
         zeta_bl = below / v.sum(axis=1, keepdims=True)
-        count = np.bincount(base, minlength=n_base)
-        xy = np.stack([np.bincount(base, d["cell_centres"][:, i], minlength=n_base) / count
-                       for i in (0, 1)], axis=1)
-        return cls(base, layer, zeta_bl[base, layer], xy)
+        return cls(base, layer, zeta_bl[base, layer], np.stack([s.base_x, s.base_y], axis=1))
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -132,12 +132,6 @@ def steady_test(history: list[case_fields.Sample], window: float, tol: float,
     return None
 
 
-def _steady(history: list[case_fields.Sample], window: float, tol: float,
-            length_scale: float) -> bool:
-    """Whether either steady-state test passes (:func:`steady_test`)."""
-    return steady_test(history, window, tol, length_scale) is not None
-
-
 def _set_stop(case: Path, value: str) -> None:
     with FoamFile(case / "system" / "controlDict") as f:
         f["stopAt"] = value

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from runs.case_fields import Sample
-from runs.run_case import _steady, mass_balance, steady_test
+from runs.run_case import mass_balance, steady_test
 
 
 def history(volumes, menisci, dt=0.01, state="I"):
@@ -18,12 +18,12 @@ def history(volumes, menisci, dt=0.01, state="I"):
 
 def test_steady_after_one_unchanged_transit():
     h = history([1.0] * 12, [3.0] * 12)
-    assert _steady(h, window=0.1, tol=0.01, length_scale=10.0)
+    assert steady_test(h, window=0.1, tol=0.01, length_scale=10.0) is not None
 
 
 def test_not_steady_before_one_transit_has_passed():
     h = history([1.0] * 5, [3.0] * 5)
-    assert not _steady(h, window=0.1, tol=0.01, length_scale=10.0)
+    assert steady_test(h, window=0.1, tol=0.01, length_scale=10.0) is None
 
 
 @pytest.mark.parametrize("volumes, menisci", [
@@ -31,13 +31,14 @@ def test_not_steady_before_one_transit_has_passed():
     ([1.0] * 12, [3.0] * 11 + [3.2]),           # meniscus moved by 0.2 a > 0.1 a
 ])
 def test_not_steady_while_something_changes(volumes, menisci):
-    assert not _steady(history(volumes, menisci), window=0.1, tol=0.01, length_scale=10.0)
+    assert steady_test(history(volumes, menisci), window=0.1, tol=0.01,
+                       length_scale=10.0) is None
 
 
 def test_not_steady_when_the_state_flips():
     h = history([1.0] * 12, [3.0] * 12)
     h[-1].pattern["state"] = "II"
-    assert not _steady(h, window=0.1, tol=0.01, length_scale=10.0)
+    assert steady_test(h, window=0.1, tol=0.01, length_scale=10.0) is None
 
 
 def fluctuating(n, volume_drift=0.0):
