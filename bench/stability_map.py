@@ -41,7 +41,8 @@ def point(M: float, L: float, grid: int | None) -> dict:
     row = dict(M=M, L=L, grid=s.get("grid"), status=status, converged=bool(s["converged"]), residual=res,
                load_error=s.get("load_error"), cycles=s.get("cycles"), wall_s=s["wall_s"],
                hc_over_nvm=hc_ratio, hmin_positive=(s.get("hmin_m") or -1) > 0,
-               failure=s.get("failure"), continuation=s.get("continuation_M"))
+               failure=s.get("failure"), continuation=s.get("continuation_M"),
+               stalled_at_cycle=s.get("stalled_at_cycle"))
     log(f"M={M:>6g} L={L:>4g}: {status:10} cycles={row['cycles']} "
         f"res={row['residual']} hc/NVM={hc_ratio} wall={row['wall_s']:.1f}s {row['failure'] or ''}")
     return row

@@ -27,7 +27,7 @@ _OPTIONS = {
     "--density": ("density", str, "dowson-higginson (default) or incompressible"),
     "--cavitation": ("cavitation", str, "complementarity (default, p >= 0) or twophase"),
     "--grid": ("grid", int, "grid points per side, 2^k+1 (default: chosen from M)"),
-    "--max-cycles": ("max_cycles", int, "multigrid cycle limit (default 60)"),
+    "--max-cycles": ("max_cycles", int, "multigrid cycle limit (default 100)"),
 }
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.ndimage import minimum_filter
@@ -53,6 +53,9 @@ class SolverOptions:
     tol_load: relative load-balance error to reach.
     max_ln_eta_step: largest change of ln(eta / eta0) one relaxation sweep may make at a
         point (see :func:`limit_viscosity_step`); 0 switches the limiter off.
+    stall_window, stall_ratio: the cycles stall when the best residual of the last
+        ``stall_window`` cycles is not below ``stall_ratio`` times the best of the window
+        before; the solve then goes on with :meth:`stalled` options (once).
     """
 
     nu1: int = 2
@@ -66,10 +69,21 @@ class SolverOptions:
     coarse_rounds: int = 1
     h0_gain: float = 0.05
     fmg_cycles: int = 2
-    max_cycles: int = 60
+    max_cycles: int = 100
     tol_residual: float = 3e-5
     tol_load: float = 3e-5
     max_ln_eta_step: float = 2.0
+    stall_window: int = 8
+    limit_correction: bool = False
+    stall_ratio: float = 0.7
+
+    def stalled(self) -> "SolverOptions":
+        """Options for the rest of a stalled solve (large L: a limit cycle between the pressure
+        spike's side lobes and the coarse-grid correction): half the distributive-Jacobi
+        under-relaxation, five more fine sweeps after each coarse-grid correction, and the
+        correction itself held to the viscosity-step limit."""
+        return replace(self, w_ja=0.5 * self.w_ja, nu2=self.nu2 + 5, limit_correction=True,
+                       stall_window=0)
 
 
 @dataclass
@@ -205,6 +219,8 @@ class MGResult:
     history: list = field(default_factory=list)
     wall_s: float = 0.0
     failure: str = ""
+    #: cycle after which the stalled-solve options were used (None: never)
+    stalled_at: int | None = None
 
 
 class MultigridSolver:
@@ -269,10 +285,21 @@ class MultigridSolver:
         corr = _prolong_bilinear(co.P - P_hat)
         # no correction inside the cavitated region, nor on its boundary
         corr[~minimum_filter(lv.P > prob.p_floor, size=3, mode="constant", cval=False)] = 0.0
+        P_before = lv.P.copy() if opt.limit_correction else None
         lv.P += corr
         self._enforce_bc(lv)
+        if P_before is not None:
+            limit_viscosity_step(P_before, lv.P, prob.laws, opt.max_ln_eta_step)
         for _ in range(opt.nu2):
             lv.relax(self.H0, prob, opt)
+
+    def _stalled(self, history: list) -> bool:
+        """Whether the last cycles stalled (see :class:`SolverOptions`)."""
+        w = self.opt.stall_window
+        if w <= 0 or len(history) < 2 * w + 1:
+            return False
+        res = [h[1] for h in history]
+        return min(res[-w:]) > self.opt.stall_ratio * min(res[-2 * w:-w])
 
     def measure(self) -> tuple[float, float, MGResult | None]:
         lv = self.levels[-1]
@@ -286,7 +313,7 @@ class MultigridSolver:
     def solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
         """Solve from a Hertzian start by FMG, or from ``P_init`` (finest grid) by cycles."""
         t0 = time.perf_counter()
-        opt = self.opt
+        opt = base_opt = self.opt
         self.H0 = H0_guess
         history = []
         if P_init is not None:
@@ -313,6 +340,7 @@ class MultigridSolver:
         converged = False
         failure = ""
         cycles = 0
+        stalled_at = None
         res, load_err, H = self.measure()
         history.append((0, res, load_err, self.H0, time.perf_counter() - t0))
         while cycles < opt.max_cycles:
@@ -322,13 +350,18 @@ class MultigridSolver:
             if res < opt.tol_residual and load_err < opt.tol_load:
                 converged = True
                 break
+            if self._stalled(history):
+                self.opt = opt = opt.stalled()
+                stalled_at = cycles
             self._cycle(len(self.levels) - 1)
             cycles += 1
             res, load_err, H = self.measure()
             history.append((cycles, res, load_err, self.H0, time.perf_counter() - t0))
+        self.opt = base_opt  # the stalled options hold for this solve only
         if not converged and not failure:
             failure = (f"not converged after {cycles} cycles: residual {res:.3g} "
                        f"(tol {opt.tol_residual:g}), load error {load_err:.3g} (tol {opt.tol_load:g})")
         return MGResult(P=lv.P.copy(), H=H, H0=self.H0, x=lv.x.copy(), y=lv.y.copy(),
                         converged=converged, residual=res, load_error=load_err, cycles=cycles,
-                        history=history, wall_s=time.perf_counter() - t0, failure=failure)
+                        history=history, wall_s=time.perf_counter() - t0, failure=failure,
+                        stalled_at=stalled_at)

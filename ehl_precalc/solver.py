@@ -96,6 +96,8 @@ class PrecalcResult:
             "residual": self.mg.residual,
             "load_error": self.mg.load_error,
             "cycles": self.mg.cycles,
+            # cycle from which the stalled-solve relaxation was used (None: never)
+            "stalled_at_cycle": self.mg.stalled_at,
             "grid": [self.domain.nx, self.domain.ny],
             "domain_over_a": [self.domain.x_min, self.domain.x_max, -self.domain.y_half,
                               self.domain.y_half],

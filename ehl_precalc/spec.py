@@ -66,7 +66,7 @@ class PrecalcSpec(BaseModel):
     cavitation: Literal["complementarity", "twophase"] = "complementarity"
     twophase_p_scale: float = Field(P_AMBIENT_PA, gt=0.0, le=1e7)
     grid: int | None = None
-    max_cycles: int = Field(60, ge=1, le=1000)
+    max_cycles: int = Field(100, ge=1, le=1000)
     tol_residual: float = Field(3e-5, gt=0.0, lt=1.0)
     tol_load: float = Field(3e-5, gt=0.0, lt=1.0)
 
