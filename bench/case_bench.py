@@ -3,7 +3,7 @@ state per resolution level, with the flow-pattern metrics each level gives.
 
     python bench/case_bench.py [--levels coarse medium fine] [--speed 0.008]
         [--supply layers --layer 2e-6 --track 3e-4] [--jobs 2] [--wall-limit 3600]
-        [--sequence] [--procs N] [--collect]
+        [--sequence] [--start-from LEVEL] [--procs N] [--collect]
 
 Each level runs serially (one core; ``--procs`` ranks with mpirun); ``--jobs`` runs levels side
 by side. ``--sequence`` runs the levels one after the other, each starting from the previous
@@ -81,17 +81,22 @@ def main(argv=None) -> int:
     ap.add_argument("--sequence", action="store_true",
                     help="each level starts from the previous level's final fields")
     ap.add_argument("--procs", type=int, default=1, help="MPI ranks per case")
+    ap.add_argument("--start-from", default=None, metavar="LEVEL",
+                    help="the first level starts from the final fields of LEVEL, already run "
+                         "under --tag (grid sequencing without re-running LEVEL)")
     ap.add_argument("--collect", action="store_true",
                     help="only tabulate the levels already run under --tag")
     ap.add_argument("--work", default=str(ROOT / "runs" / "bench"))
     args = ap.parse_args(argv)
     previous = {level: (args.levels[i - 1] if i and args.sequence else None)
                 for i, level in enumerate(args.levels)}
+    if args.start_from:
+        previous[args.levels[0]] = args.start_from
     if args.collect:
         rows = [row_of(Path(args.work) / args.tag / level, level, previous[level])
                 for level in args.levels
                 if (Path(args.work) / args.tag / level / "metrics.json").is_file()]
-    elif args.sequence:
+    elif args.sequence or args.start_from:
         rows = [one(level, args, previous[level]) for level in args.levels]
     else:
         with ProcessPoolExecutor(max_workers=args.jobs) as pool:
