@@ -38,7 +38,8 @@ def point(M: float, L: float, grid: int | None) -> dict:
     res = s.get("residual")
     status = ("converged" if s["converged"] else
               "stagnated" if res is not None and res < 10 * 3e-5 else "failed")
-    row = dict(M=M, L=L, grid=s.get("grid"), status=status, converged=bool(s["converged"]), residual=res,
+    row = dict(M=M, L=L, grid=s.get("grid"), status=status, converged=bool(s["converged"]),
+               residual=res,
                load_error=s.get("load_error"), cycles=s.get("cycles"), wall_s=s["wall_s"],
                hc_over_nvm=hc_ratio, hmin_positive=(s.get("hmin_m") or -1) > 0,
                failure=s.get("failure"), continuation=s.get("continuation_M"),
@@ -81,14 +82,15 @@ def main() -> None:
     ap.add_argument("--grid", default="257", help="points a side, or 'default'")
     ap.add_argument("--m-max", type=float, default=max(M_VALUES))
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--replot", action="store_true", help="only redraw the saved map")
+    ap.add_argument("--replot", action="store_true",
+                    help="only redraw the saved map of --grid")
     args = ap.parse_args()
-    if args.replot:
-        data = json.loads((RESULTS / "stability_map.json").read_text())
-        plot(data["points"], data["grid"])
-        return
     grid = None if args.grid == "default" else int(args.grid)
     name = "stability_map" if grid is not None else "stability_map_default"
+    if args.replot:
+        data = json.loads((RESULTS / f"{name}.json").read_text())
+        plot(data["points"], data["grid"], name)
+        return
     pts = [(M, L) for L in L_VALUES for M in M_VALUES if M <= args.m_max]
     with ThreadPoolExecutor(args.jobs) as ex:
         rows = list(ex.map(lambda ml: point(ml[0], ml[1], grid), pts))

@@ -53,6 +53,8 @@ class SolverOptions:
     tol_load: relative load-balance error to reach.
     max_ln_eta_step: largest change of ln(eta / eta0) one relaxation sweep may make at a
         point (see :func:`limit_viscosity_step`); 0 switches the limiter off.
+    limit_correction: hold the coarse-grid correction to the same viscosity-step limit as
+        the sweeps (used once a solve stalls).
     stall_window, stall_ratio: the cycles stall when the best residual of the last
         ``stall_window`` cycles is not below ``stall_ratio`` times the best of the window
         before; the solve then goes on with :meth:`stalled` options (once).
@@ -73,8 +75,8 @@ class SolverOptions:
     tol_residual: float = 3e-5
     tol_load: float = 3e-5
     max_ln_eta_step: float = 2.0
-    stall_window: int = 8
     limit_correction: bool = False
+    stall_window: int = 8
     stall_ratio: float = 0.7
 
     def stalled(self) -> "SolverOptions":

@@ -46,6 +46,18 @@ class Structure:
                    zip(d["patch_names"], d["patch_starts"], d["patch_sizes"])}
         return cls(d["cell_volumes"], base, d["layer"], bx, by, patches)
 
+    def gap_mean(self, field: np.ndarray) -> np.ndarray:
+        """Per base cell, the volume-weighted mean of a cell field over the column across the
+        gap (a scalar field gives shape (n_base,), a vector field (n_base, k))."""
+        n_base = len(self.base_x)
+        w = self.cell_volumes
+        col = np.bincount(self.base_cell, w, minlength=n_base)
+        f = np.asarray(field, float)
+        if f.ndim == 1:
+            return np.bincount(self.base_cell, f * w, minlength=n_base) / col
+        return np.stack([np.bincount(self.base_cell, f[:, k] * w, minlength=n_base)
+                         for k in range(f.shape[1])], axis=1) / col[:, None]
+
     def mid_gap(self, field: np.ndarray, n_layers: int) -> np.ndarray:
         """Per base cell, the value at mid-gap (the middle layer, or the mean of the two
         middle layers for an even count)."""

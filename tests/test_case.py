@@ -130,6 +130,20 @@ def test_checkmesh_passes(small_case):
     assert f"cells:            {load_geometry(small_case).cells}" in log
 
 
+def test_gap_mean_weights_each_column_by_volume(small_case):
+    from runs import case_fields
+
+    st = case_fields.Structure.load(small_case)
+    assert np.allclose(st.gap_mean(np.ones_like(st.cell_volumes)), 1.0)
+    # the layer index, averaged by hand over one column
+    col = st.base_cell == st.base_cell[0]
+    by_hand = (st.layer[col] * st.cell_volumes[col]).sum() / st.cell_volumes[col].sum()
+    assert st.gap_mean(st.layer)[st.base_cell[0]] == pytest.approx(by_hand, rel=1e-12)
+    vec = st.gap_mean(np.stack([st.layer, 2.0 * st.layer], axis=1))
+    assert vec.shape == (len(st.base_x), 2)
+    assert np.allclose(vec[:, 1], 2.0 * st.gap_mean(st.layer))
+
+
 def test_supply_enters_only_on_the_track(small_case):
     from foamlib import FoamFieldFile
 
