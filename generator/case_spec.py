@@ -109,8 +109,12 @@ class Physics(BaseModel):
         ambient_pressure: [Pa, absolute] at the open boundaries (cavitating scene; the
             interface scene works in gauge pressure and adds it only to report one).
         cavitation_pressure: [Pa, absolute] the pressure floor of the cavitating scene
-            (compressibleInterFoam's pMin). The reference assumes 0; a perfect gas needs a
+            (compressibleInterFoam's pMin) and the pressure below which the gas-release
+            scene releases gas from the oil. The reference assumes 0; a perfect gas needs a
             positive floor, so the default is 1 kPa (sensitivity in docs/cavitation.md).
+        gas_release_rate: [1/(Pa s)] of the gas-release scene: oil below the cavitation
+            pressure releases gas at k (p_cav - p) volumes of gas per volume of oil per
+            second, which is never taken back (Kunz's model without its condensation term).
         oil_bulk_modulus: [Pa] of the oil in the cavitating scene (assumed 1.5 GPa, a
             mineral oil's isothermal value at ambient pressure).
     """
@@ -126,6 +130,7 @@ class Physics(BaseModel):
     ambient_pressure: float = Field(1.013e5, gt=1e3, le=1e7)
     cavitation_pressure: float = Field(1e3, gt=0.0, le=1e5)
     oil_bulk_modulus: float = Field(1.5e9, gt=1e6, le=1e11)
+    gas_release_rate: float = Field(1e-3, gt=0.0, le=1e3)
 
 
 class Domain(BaseModel):
@@ -227,7 +232,7 @@ class Run(BaseModel):
 
 #: The OpenFOAM application of each scene.
 SOLVERS = {"interface": "interFoam", "single-phase": "interFoam",
-           "cavitating": "compressibleInterFoam"}
+           "cavitating": "compressibleInterFoam", "gas-release": "interPhaseChangeFoam"}
 
 
 class CaseSpec(BaseModel):
@@ -239,13 +244,16 @@ class CaseSpec(BaseModel):
             "single-phase": oil everywhere (the check against the Reynolds solution);
             "cavitating": two-phase oil/air where the air is a perfect gas that expands
             below ambient pressure, down to the cavitation pressure (compressibleInterFoam).
+            "gas-release": incompressible oil and air, and oil below the cavitation pressure
+            turns into gas at physics.gas_release_rate (interPhaseChangeFoam, Kunz's
+            vaporisation term only): the gas that makes a bubble where no air reaches.
         contact: the EHL conditions (:class:`ehl_precalc.spec.PrecalcSpec`).
         walls_moving: False holds both walls still (the static-meniscus test).
     """
 
     model_config = _STRICT
     name: str = "case"
-    scene: Literal["interface", "single-phase", "cavitating"] = "interface"
+    scene: Literal["interface", "single-phase", "cavitating", "gas-release"] = "interface"
     contact: PrecalcSpec = PrecalcSpec(speed=0.008)
     supply: Supply = Supply()
     physics: Physics = Physics()

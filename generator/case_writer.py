@@ -285,6 +285,7 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
     else:
         _edit_transport(spec, case)
     with FoamFile(case / "system" / "controlDict") as f:
+        f["application"] = spec.solver
         f["endTime"] = geom.end_time
         f["writeInterval"] = geom.write_interval
         f["maxCo"] = spec.run.max_courant
@@ -298,7 +299,8 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
 
 
 def _edit_transport(spec: CaseSpec, case: Path) -> None:
-    """interFoam's two incompressible phases and the surface tension."""
+    """interFoam's two incompressible phases and the surface tension; in the gas-release
+    scene also interPhaseChangeFoam's mass transfer (:func:`gas_release_entries`)."""
     p = spec.physics
     with FoamFile(case / "constant" / "transportProperties") as f:
         f["oil"]["nu"] = spec.oil_viscosity / spec.oil_density
@@ -306,6 +308,22 @@ def _edit_transport(spec: CaseSpec, case: Path) -> None:
         f["air"]["nu"] = p.air_viscosity * spec.run.air_viscosity_factor / p.air_density
         f["air"]["rho"] = p.air_density
         f["sigma"] = p.surface_tension
+        if spec.scene == "gas-release":
+            for key, value in gas_release_entries(spec).items():
+                f[key] = value
+
+
+def gas_release_entries(spec: CaseSpec) -> dict:
+    """interPhaseChangeFoam's Kunz model as a one-way gas release: below pSat (the cavitation
+    pressure, gauge like the solver's p) oil turns into gas at
+    mdot = Cv rho_gas / (0.5 rho_oil UInf^2 tInf) (pSat - p) alpha_oil [kg/(m3 s)], i.e.
+    k (pSat - p) volumes of gas per volume of oil per second with UInf = tInf = 1 and
+    Cv = 0.5 rho_oil k; Cc = 0: the gas is never dissolved back."""
+    p = spec.physics
+    return {"phaseChangeTwoPhaseMixture": "Kunz",
+            "pSat": p.cavitation_pressure - p.ambient_pressure,
+            "KunzCoeffs": {"UInf": 1.0, "tInf": 1.0, "Cc": 0.0,
+                           "Cv": 0.5 * spec.oil_density * p.gas_release_rate}}
 
 
 def _edit_thermo(spec: CaseSpec, case: Path) -> None:
@@ -411,7 +429,7 @@ def _write_interval(spec: CaseSpec) -> float:
 
 def _template_for(spec: CaseSpec) -> str:
     return {"interface": "interface", "single-phase": "interface",
-            "cavitating": "cavitating"}[spec.scene]
+            "cavitating": "cavitating", "gas-release": "interface"}[spec.scene]
 
 
 def _read_json(path: Path) -> dict:

@@ -161,7 +161,10 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
             _complete(folder / name)
     alpha, alpha_file = _read_alpha(folder / "alpha.oil", structure)
     volume = _oil_volume(alpha, structure, geom)
-    # the oil flux MULES transported (alphaPhi0.oil); phi * face alpha where it is absent
+    # the oil flux MULES transported (alphaPhi0.oil); where the solver does not write it
+    # (interPhaseChangeFoam), phi times the face alpha, and no oil flowing in through the
+    # boundaries open to the air (their inletValue; the written face values of inflow faces
+    # there are not what was transported)
     oil_flux_file = folder / "alphaPhi0.oil"
     flux_bf = FoamFieldFile(oil_flux_file if oil_flux_file.exists() else folder / "phi").boundary_field
     alpha_bf = alpha_file.boundary_field
@@ -170,6 +173,8 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
         flux = _uniform_or_list(flux_bf[name]["value"], size)
         if not oil_flux_file.exists():
             flux = flux * np.clip(_uniform_or_list(alpha_bf[name]["value"], size), 0.0, 1.0)
+            if name != "supply":
+                flux = np.maximum(flux, 0.0)
         return flux
 
     q_in, q_out = _in_out(oil_flux, structure, geom)

@@ -251,6 +251,31 @@ def test_cavitating_case_runs_a_few_steps(tmp_path):
     assert "bubble_volume_m3" in header and "min_pressure_Pa" in header
 
 
+def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
+    """The gas-release scene (interPhaseChangeFoam, Kunz's vaporisation term only, no
+    condensation): oil below the release pressure turns into gas, so the suction behind the
+    contact, which reaches ~13 kPa absolute without it in this case, stays at the release
+    pressure."""
+    p_release = 9e4
+    spec = make_case_spec({**SMALL, "scene": "gas-release",
+                           "physics": {"cavitation_pressure": p_release,
+                                       "gas_release_rate": 1.0}})
+    case = tmp_path / "gr"
+    geom = write_case(spec, case)
+    assert geom.solver == "interPhaseChangeFoam" and not geom.absolute_pressure
+    with FoamFile(case / "constant" / "transportProperties") as f:
+        assert f["phaseChangeTwoPhaseMixture"] == "Kunz"
+        assert f["pSat"] == pytest.approx(p_release - spec.physics.ambient_pressure)
+        assert f["KunzCoeffs"]["Cc"] == 0.0
+    with FoamFile(case / "system" / "controlDict") as f:
+        assert f["application"] == "interPhaseChangeFoam"
+    m = run_case(case, wall_limit=120)
+    assert m["status"] == "finished" and m["end_reason"] == "end_time", m
+    assert (case / "log.interPhaseChangeFoam").read_text().rstrip().endswith("End")
+    assert 0.97 * p_release < m["min_pressure_Pa"] < spec.physics.ambient_pressure
+    assert m["oil_mass_balance_error"] < 0.1
+
+
 def test_cavitating_case_starts_from_another_cases_fields(tmp_path):
     """A ramp step of the cavitating scene: the previous case's final fields (lists, p and T
     included) as the start; the case must read them (no $internalField in list fields)."""
