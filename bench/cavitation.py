@@ -41,6 +41,7 @@ U20 = {"contact.speed": 0.020, "contact.temperature": 25.0}
 THIN = {"supply.disc_layer": 2e-6, "supply.ball_layer": 2e-6}
 SEED = {"supply.initial_bubble": 1.0}
 L3 = {"supply.disc_layer": 3e-6, "supply.ball_layer": 3e-6}
+GR = {"scene": "gas-release", "mesh.resolution": "coarse"}
 
 #: name -> overrides on runs/nominal.toml
 RUNS: dict[str, dict] = {
@@ -62,11 +63,21 @@ RUNS: dict[str, dict] = {
     "u20_T25_3um_K0.75": {**CAV, **U20, **L3, "physics.oil_bulk_modulus": 0.75e9},
     "u20_T25_3um_K3": {**CAV, **U20, **L3, "physics.oil_bulk_modulus": 3e9},
     "u20_T25_3um_interface": {**CAV, **U20, **L3, "scene": "interface"},
+    # the gas-release scene (interPhaseChangeFoam, one-way Kunz): gas where no air reaches
+    "gr_u8_8um": {**GR, **U8},
+    "gr_u8_8um_pcav30k": {**GR, **U8, "physics.cavitation_pressure": 3e4},
+    "gr_u8_8um_pcav60k": {**GR, **U8, "physics.cavitation_pressure": 6e4},
+    "gr_u20_T25_8um": {**GR, **U20},
+    "gr_u20_T25_8um_medium": {**GR, **U20, "mesh.resolution": "medium"},
+    "gr_u20_T25_8um_fine": {**GR, **U20, "mesh.resolution": "fine", "run.transits_max": 2.0},
+    "gr_u20_T25_8um_k1e-4": {**GR, **U20, "physics.gas_release_rate": 1e-4},
+    "gr_u20_T25_8um_k1e-2": {**GR, **U20, "physics.gas_release_rate": 1e-2},
+    "gr_u20_T25_8um_pcav30k": {**GR, **U20, "physics.cavitation_pressure": 3e4},
 }
 #: name -> the run whose final fields it starts from (interpolated onto its mesh): the fine level
 #: starts from the converged coarse bubble and runs 2 transits (1 to forget the start, the last
 #: one measured), which costs half of 4 transits from the standard start.
-SEEDED_FROM = {"u20_T25_3um_fine": "u20_T25_3um"}
+SEEDED_FROM = {"u20_T25_3um_fine": "u20_T25_3um", "gr_u20_T25_8um_fine": "gr_u20_T25_8um_medium"}
 #: Wall-clock limit of one run [s]: the medium and fine levels need more than the default hour.
 WALL_LIMIT = 8 * 3600.0
 KEYS = ("state", "gas_mass_balance_error", "bubble_length_over_a", "bubble_width_over_a", "bubble_volume_m3",

@@ -49,6 +49,8 @@ def _copy(case: Path, tmp_path: Path) -> Path:
     ("[domain]\nisland_radius = 9.0\n", "island_radius = 9 a", "nearest boundary"),
     ("[contact]\ntemperature = 99.0\n", "temperature = 99 C", "valid range 25 to 60 C"),
     ("[run]\nsteady_tolerance = 2.0\n", "run.steady_tolerance = 2.0", "steady_tolerance < 1"),
+    ("scene = \"gas-release\"\n[physics]\ngas_release_rate = 0.0\n",
+     "physics.gas_release_rate = 0.0", "0 < physics.gas_release_rate"),
 ])
 def test_bad_spec_fails_before_anything_is_written(tmp_path, table, text, expected):
     spec = tmp_path / "bad.toml"
