@@ -3,7 +3,7 @@ state per resolution level, with the flow-pattern metrics each level gives.
 
     python bench/case_bench.py [--levels coarse medium fine] [--speed 0.008]
         [--supply layers --layer 2e-6 --track 3e-4] [--jobs 2] [--wall-limit 3600]
-        [--sequence] [--start-from LEVEL] [--procs N] [--run KEY=VALUE ...] [--collect]
+        [--sequence] [--start-from LEVEL] [--procs N] [--set KEY=VALUE ...] [--collect]
 
 Each level runs serially (one core; ``--procs`` ranks with mpirun); ``--jobs`` runs levels side
 by side. ``--sequence`` runs the levels one after the other, each starting from the previous
@@ -42,13 +42,20 @@ KEYS = ("state", "inlet_meniscus_distance_over_a", "inlet_meniscus_shape",
 def one(level: str, args: argparse.Namespace, previous: str | None = None) -> dict:
     """Build and run ``level``; started from the final fields of the level ``previous`` (a
     sibling case) when given."""
-    spec = make_case_spec({
+    table = {
         "name": f"bench-{level}", "contact": {"speed": args.speed},
         "mesh": {"resolution": level},
         "supply": {"mode": args.supply, "disc_layer": args.layer, "ball_layer": args.layer,
                    "track_half_width": args.track},
         "run": {"wall_limit": args.wall_limit, "transits_max": args.transits,
-                "n_procs": args.procs, **dict(args.run)}})
+                "n_procs": args.procs}}
+    for key, value in args.set:
+        *parents, leaf = key.split(".")
+        node = table
+        for part in parents:
+            node = node.setdefault(part, {})
+        node[leaf] = value
+    spec = make_case_spec(table)
     case = Path(args.work) / args.tag / level
     t0 = time.perf_counter()
     write_case(spec, case, overwrite=True)
@@ -67,12 +74,12 @@ def row_of(case: Path, level: str, previous: str | None, build_s: float | None =
             **{k: m.get(k) for k in KEYS}}
 
 
-def run_option(text: str) -> tuple[str, float | str]:
-    """``KEY=VALUE`` of a ``[run]`` spec option; the value as a number where it reads as one
-    (the spec validates it)."""
+def spec_option(text: str) -> tuple[str, float | str]:
+    """``KEY=VALUE`` of a spec option (dotted key, e.g. ``run.max_courant=1``); the value as a
+    number where it reads as one (the spec validates it)."""
     key, sep, value = text.partition("=")
     if not sep or not key:
-        raise argparse.ArgumentTypeError(f"--run wants KEY=VALUE, got {text!r}")
+        raise argparse.ArgumentTypeError(f"--set wants KEY=VALUE, got {text!r}")
     try:
         return key, float(value)
     except ValueError:
@@ -98,8 +105,9 @@ def main(argv=None) -> int:
                          "under --tag (grid sequencing without re-running LEVEL)")
     ap.add_argument("--collect", action="store_true",
                     help="only tabulate the levels already run under --tag")
-    ap.add_argument("--run", action="append", default=[], type=run_option, metavar="KEY=VALUE",
-                    help="a [run] option of the spec, e.g. capillary_safety=3 (repeatable)")
+    ap.add_argument("--set", action="append", default=[], type=spec_option, metavar="KEY=VALUE",
+                    help="a spec option, e.g. run.max_courant=1 or supply.initial_puddle=5 "
+                         "(repeatable)")
     ap.add_argument("--work", default=str(ROOT / "runs" / "bench"))
     args = ap.parse_args(argv)
     previous = {level: (args.levels[i - 1] if i and args.sequence else None)

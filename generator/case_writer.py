@@ -293,6 +293,7 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
         f["maxDeltaT"] = geom.max_delta_t
     with FoamFile(case / "system" / "fvSolution") as f:
         f["solvers"]['"alpha.oil.*"']["cAlpha"] = spec.physics.interface_compression
+        f["PIMPLE"]["nCorrectors"] = spec.run.pressure_correctors
     with FoamFile(case / "system" / "decomposeParDict") as f:
         f["numberOfSubdomains"] = spec.run.n_procs
         f["coeffs"]["n"] = [spec.run.n_procs, 1, 1]

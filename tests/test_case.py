@@ -19,7 +19,7 @@ from foamlib import FoamFile
 
 from ehl_precalc.spec import SpecError
 from generator.case_spec import make_case_spec
-from generator.case_writer import CaseExists, load_geometry, write_case
+from generator.case_writer import CaseExists, capillary_time_step, load_geometry, write_case
 from runs.foam_runtime import FoamRuntime
 from runs.run_case import run_case
 from tiny import SMALL
@@ -95,6 +95,25 @@ def test_case_is_complete_and_runs_by_hand_layout(small_case):
     geom = load_geometry(small_case)
     assert geom.gap_mismatch < 0.05      # a deliberately coarse mesh; the levels: below
     assert 0 < geom.max_delta_t < 1e-3
+
+
+def test_time_step_options_reach_the_dictionaries(tmp_path):
+    """run.max_courant, max_alpha_courant, pressure_correctors and capillary_safety are what
+    controlDict and fvSolution say; the capillary limit scales with its safety factor."""
+    spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "max_courant": 0.7,
+                                            "max_alpha_courant": 0.6, "pressure_correctors": 2,
+                                            "capillary_safety": 1.5}})
+    geom = write_case(spec, tmp_path / "opts")
+    with FoamFile(tmp_path / "opts" / "system" / "controlDict") as f:
+        assert (f["maxCo"], f["maxAlphaCo"]) == (0.7, 0.6)
+        assert f["maxDeltaT"] == pytest.approx(geom.max_delta_t)
+    assert FoamFile(tmp_path / "opts" / "system" / "fvSolution")["PIMPLE"]["nCorrectors"] == 2
+    dx = geom.min_cell_size
+    assert geom.max_delta_t == pytest.approx(min(capillary_time_step(spec, dx),
+                                                 geom.write_interval))
+    default = make_case_spec(SMALL)           # capillary_safety 3 (the default)
+    assert capillary_time_step(spec, dx) == pytest.approx(
+        capillary_time_step(default, dx) * 1.5 / 3.0, rel=1e-12)
 
 
 @pytest.mark.parametrize("level", ["coarse", "medium"])
