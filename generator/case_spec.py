@@ -253,6 +253,8 @@ class CaseSpec(BaseModel):
             "gas-release": incompressible oil and air, and oil below the cavitation pressure
             turns into gas at physics.gas_release_rate (interPhaseChangeFoam, Kunz's
             vaporisation term only): the gas that makes a bubble where no air reaches.
+            Experimental: interPhaseChangeFoam does not reproduce interFoam's flow even with
+            no release (docs/cavitation.md).
         contact: the EHL conditions (:class:`ehl_precalc.spec.PrecalcSpec`).
         walls_moving: False holds both walls still (the static-meniscus test).
     """
