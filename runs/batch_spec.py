@@ -59,9 +59,11 @@ PARAM_KEYS = ("speed_mm_s", "temperature_C", "load_N", "supply", "disc_layer_um"
               "ball_layer_um", "resolution")
 
 #: Rough cost model for ordering (longest first) and the first ETA: CPU seconds per simulated
-#: millisecond per resolution level (docs/cases.md, "The re-levelled meshes", 8 mm/s), plus a
-#: fixed build cost and the EHL precalc of a new contact.
-CPU_PER_SIMULATED_MS = {"coarse": 0.50, "medium": 2.5, "fine": 10.1}
+#: millisecond per resolution level with the time-step defaults of 2026-11-23 (docs/cases.md,
+#: "Time-step limits": coarse 0.14-0.17 s at 8 mm/s, medium 0.65-0.84 s; fine scaled from the
+#: earlier defaults by the medium level's factor), plus a fixed build cost and the EHL precalc
+#: of a new contact.
+CPU_PER_SIMULATED_MS = {"coarse": 0.17, "medium": 0.75, "fine": 3.0}
 BUILD_CPU_S = 5.0
 PRECALC_CPU_S = 60.0
 
