@@ -21,6 +21,7 @@ import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
@@ -28,6 +29,7 @@ sys.path.insert(0, str(ROOT))
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
 from common import solver_cpu_s  # noqa: E402
+from runs.cli import parse_value  # noqa: E402
 from runs.ramp import seed_from_previous  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
@@ -42,20 +44,13 @@ KEYS = ("state", "inlet_meniscus_distance_over_a", "inlet_meniscus_shape",
 def one(level: str, args: argparse.Namespace, previous: str | None = None) -> dict:
     """Build and run ``level``; started from the final fields of the level ``previous`` (a
     sibling case) when given."""
-    table = {
+    spec = make_case_spec({
         "name": f"bench-{level}", "contact": {"speed": args.speed},
         "mesh": {"resolution": level},
         "supply": {"mode": args.supply, "disc_layer": args.layer, "ball_layer": args.layer,
                    "track_half_width": args.track},
         "run": {"wall_limit": args.wall_limit, "transits_max": args.transits,
-                "n_procs": args.procs}}
-    for key, value in args.set:
-        *parents, leaf = key.split(".")
-        node = table
-        for part in parents:
-            node = node.setdefault(part, {})
-        node[leaf] = value
-    spec = make_case_spec(table)
+                "n_procs": args.procs}}, **dict(args.set))
     case = Path(args.work) / args.tag / level
     t0 = time.perf_counter()
     write_case(spec, case, overwrite=True)
@@ -74,16 +69,13 @@ def row_of(case: Path, level: str, previous: str | None, build_s: float | None =
             **{k: m.get(k) for k in KEYS}}
 
 
-def spec_option(text: str) -> tuple[str, float | str]:
-    """``KEY=VALUE`` of a spec option (dotted key, e.g. ``run.max_courant=1``); the value as a
-    number where it reads as one (the spec validates it)."""
+def spec_option(text: str) -> tuple[str, Any]:
+    """``KEY=VALUE`` of a spec option (dotted key, e.g. ``run.max_courant=1``), the value read
+    as ``ehlfoam case --set`` reads it (the spec validates it)."""
     key, sep, value = text.partition("=")
     if not sep or not key:
         raise argparse.ArgumentTypeError(f"--set wants KEY=VALUE, got {text!r}")
-    try:
-        return key, float(value)
-    except ValueError:
-        return key, value
+    return key, parse_value(value)
 
 
 def main(argv=None) -> int:

@@ -19,7 +19,8 @@ from generator.case_writer import AIR_GAS_CONSTANT, META, CaseGeometry
 
 from . import metrics
 
-OPEN_PATCHES = ("supply", "inlet", "outlet", "side")
+SUPPLY_PATCH = "supply"
+OPEN_PATCHES = (SUPPLY_PATCH, "inlet", "outlet", "side")
 
 
 @dataclass
@@ -173,7 +174,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
         flux = _uniform_or_list(flux_bf[name]["value"], size)
         if not oil_flux_file.exists():
             flux = flux * np.clip(_uniform_or_list(alpha_bf[name]["value"], size), 0.0, 1.0)
-            if name != "supply":
+            if name != SUPPLY_PATCH:
                 flux = np.maximum(flux, 0.0)
         return flux
 

@@ -53,7 +53,7 @@ def cmd_case(args: argparse.Namespace) -> int:
 
     overrides = dict(kv.split("=", 1) for kv in args.set or [])
     try:
-        overrides = {k: _parse_value(v) for k, v in overrides.items()}
+        overrides = {k: parse_value(v) for k, v in overrides.items()}
         spec = (load_case_spec(args.spec, **overrides) if args.spec
                 else make_case_spec(None, **overrides))
     except (SpecError, ValueError) as err:
@@ -71,7 +71,7 @@ def cmd_case(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _parse_value(text: str):
+def parse_value(text: str):
     """A --set value: TOML scalar syntax (numbers, booleans, quoted or bare strings)."""
     import tomllib
 
