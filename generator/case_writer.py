@@ -328,17 +328,21 @@ def gas_release_entries(spec: CaseSpec) -> dict:
 
 
 def _edit_thermo(spec: CaseSpec, case: Path) -> None:
-    """compressibleInterFoam's phases: the oil a perfect fluid of the given bulk modulus
-    (rho = rho0 + p/(R T), R = K/(rho0 T)), the air a perfect gas; surface tension and the
-    pressure floor (the cavitation pressure)."""
+    """compressibleInterFoam's phases: the oil incompressible (rhoConst), or a perfect fluid
+    when a bulk modulus K is given (rho = rho0 + p/(R T), R = K/(rho0 T)); the air a perfect
+    gas; surface tension and the pressure floor (the cavitation pressure)."""
     p, const = spec.physics, case / "constant"
     with FoamFile(const / "thermophysicalProperties") as f:
         f["sigma"] = p.surface_tension
         f["pMin"] = p.cavitation_pressure
     with FoamFile(const / "thermophysicalProperties.oil") as f:
-        f["mixture"]["equationOfState"]["rho0"] = spec.oil_density
-        f["mixture"]["equationOfState"]["R"] = (p.oil_bulk_modulus
-                                                / (spec.oil_density * spec.temperature_k))
+        if p.oil_bulk_modulus is None:
+            f["mixture"]["equationOfState"] = {"rho": spec.oil_density}
+        else:
+            f["thermoType"]["equationOfState"] = "perfectFluid"
+            f["mixture"]["equationOfState"] = {
+                "R": p.oil_bulk_modulus / (spec.oil_density * spec.temperature_k),
+                "rho0": spec.oil_density}
         f["mixture"]["transport"]["mu"] = spec.oil_viscosity
     with FoamFile(const / "thermophysicalProperties.air") as f:
         f["mixture"]["transport"]["mu"] = p.air_viscosity * spec.run.air_viscosity_factor

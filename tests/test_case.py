@@ -255,6 +255,9 @@ def test_cavitating_case_runs_a_few_steps(tmp_path):
     case = tmp_path / "cav"
     geom = write_case(spec, case)
     assert geom.solver == "compressibleInterFoam" and geom.absolute_pressure
+    with FoamFile(case / "constant" / "thermophysicalProperties.oil") as f:
+        assert f["thermoType"]["equationOfState"] == "rhoConst"     # incompressible oil
+        assert f["mixture"]["equationOfState"]["rho"] == pytest.approx(spec.oil_density)
     m = run_case(case, wall_limit=120)
     assert m["status"] == "finished" and m["end_reason"] == "end_time", m
     assert (case / "log.compressibleInterFoam").read_text().rstrip().endswith("End")
@@ -270,6 +273,22 @@ def test_cavitating_case_runs_a_few_steps(tmp_path):
     assert m["gas_mass_balance_error"] < 0.05       # the air: p/(R T) times the gas fluxes
     header = (case / "history.csv").read_text().splitlines()[0]
     assert "bubble_volume_m3" in header and "min_pressure_Pa" in header
+
+
+def test_cavitating_case_with_a_compressible_oil(tmp_path):
+    """physics.oil_bulk_modulus makes the oil a perfect fluid, R = K/(rho0 T), which the
+    solver reads and runs."""
+    k = 1.5e9
+    spec = make_case_spec({**SMALL, "scene": "cavitating", "physics": {"oil_bulk_modulus": k},
+                           "run": {**SMALL["run"], "end_time": 2e-4}})
+    case = tmp_path / "cav_k"
+    write_case(spec, case)
+    with FoamFile(case / "constant" / "thermophysicalProperties.oil") as f:
+        assert f["thermoType"]["equationOfState"] == "perfectFluid"
+        eos = f["mixture"]["equationOfState"]
+        assert eos["rho0"] * eos["R"] * spec.temperature_k == pytest.approx(k)
+    m = run_case(case, wall_limit=120)
+    assert m["status"] == "finished" and m["end_reason"] == "end_time", m
 
 
 def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
