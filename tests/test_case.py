@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from foamlib import FoamFile
+from foamlib import FoamFieldFile, FoamFile
 
 from ehl_precalc.spec import SpecError
 from generator.case_spec import make_case_spec
@@ -313,7 +313,12 @@ def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
     assert m["status"] == "finished" and m["end_reason"] == "end_time", m
     assert (case / "log.interPhaseChangeFoam").read_text().rstrip().endswith("End")
     assert 0.97 * p_release < m["min_pressure_Pa"] < spec.physics.ambient_pressure
-    assert m["oil_mass_balance_error"] < 0.1
+    # all-oil supply faces (generator.case_writer.supply_faces): 0.1 % here, 5.6 % with
+    # part-oil faces, across which interPhaseChangeFoam compresses the interface
+    assert m["oil_mass_balance_error"] < 0.01
+    with FoamFieldFile(case / "0.orig" / "U") as f:
+        u_supply = np.asarray(f.boundary_field["supply"]["value"])
+    assert u_supply.ndim == 2 and np.all(u_supply[:, 0] < spec.wall_speed)
 
 
 def test_cavitating_case_starts_from_another_cases_fields(tmp_path):
