@@ -52,6 +52,7 @@ RUNS: dict[str, dict] = {
     "u8_8um_seed1": {**CAV, **U8, **SEED},
     "u8_2um": {**CAV, **U8, **THIN},
     "u8_2um_interface": {**CAV, **U8, **THIN, "scene": "interface"},
+    "u8_8um_interface": {**CAV, **U8, "scene": "interface"},
     # 2. 25 C, 20 mm/s: the thesis's bubble (experiment 5 a, Reynolds model 0.9 a)
     "u20_T25_8um_seed1": {**CAV, **U20, **SEED},
     "u20_T25_2um": {**CAV, **U20, **THIN},
@@ -73,6 +74,9 @@ RUNS: dict[str, dict] = {
     "gr_u20_T25_8um_k1e-4": {**GR, **U20, "physics.gas_release_rate": 1e-4},
     "gr_u20_T25_8um_k1e-2": {**GR, **U20, "physics.gas_release_rate": 1e-2},
     "gr_u20_T25_8um_pcav30k": {**GR, **U20, "physics.cavitation_pressure": 3e4},
+    #    release where the oil, saturated with air at ambient pressure, falls below it
+    "gr_u8_8um_pr90k": {**GR, **U8, "physics.cavitation_pressure": 9e4},
+    "gr_u20_T25_8um_pr90k": {**GR, **U20, "physics.cavitation_pressure": 9e4},
 }
 #: name -> the run whose final fields it starts from (interpolated onto its mesh): the fine level
 #: starts from the converged coarse bubble and runs 2 transits (1 to forget the start, the last

@@ -104,6 +104,7 @@ class Sample:
     gas_mass: float | None = None   # kg of air, whole contact (compressible scenes only)
     gas_in: float | None = None     # kg/s of air entering through the open boundaries
     gas_out: float | None = None    # kg/s of air leaving
+    oil_flux_exact: bool = True     # oil fluxes from the solver's alphaPhi0, not phi x alpha
 
     def row(self) -> dict:
         keys = ("state", "inlet_meniscus_distance_over_a", "flooded_length_over_a",
@@ -189,7 +190,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     pattern["min_pressure_Pa"] = _min_pressure(p, geom)
     gas = _gas(folder, alpha, p, structure, geom) if geom.absolute_pressure else {}
     return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
-                  pattern=pattern, **gas)
+                  pattern=pattern, oil_flux_exact=oil_flux_file.exists(), **gas)
 
 
 def _in_out(face_flux, structure: Structure, geom: CaseGeometry) -> tuple[float, float]:

@@ -21,7 +21,7 @@ from ehl_precalc.spec import SpecError
 from generator.case_spec import make_case_spec
 from generator.case_writer import CaseExists, capillary_time_step, load_geometry, write_case
 from runs.foam_runtime import FoamRuntime
-from runs.run_case import run_case
+from runs.run_case import OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, run_case
 from tiny import SMALL
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -241,6 +241,7 @@ def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     # over 1 ms the outlet flux flickers between 15 writes (trapezoid error); runs to steady
     # state balance within 1 % (docs/cases.md). This catches a lost factor or sign.
     assert m["oil_mass_balance_error"] is not None and m["oil_mass_balance_error"] < 0.1
+    assert m["oil_flux_source"] == OIL_FLUX_EXACT
     assert m["oil_inflow_m3_s"] == pytest.approx(0.02 * 6e-6 * 5e-4, rel=1e-6)
     rows = (case / "history.csv").read_text().splitlines()
     assert len(rows) >= 10 and rows[0].startswith("time_s,oil_volume_m3")
@@ -316,6 +317,7 @@ def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
     # all-oil supply faces (generator.case_writer.supply_faces): 0.1 % here, 5.6 % with
     # part-oil faces, across which interPhaseChangeFoam compresses the interface
     assert m["oil_mass_balance_error"] < 0.01
+    assert m["oil_flux_source"] == OIL_FLUX_APPROXIMATE      # no alphaPhi0 written
     with FoamFieldFile(case / "0.orig" / "U") as f:
         u_supply = np.asarray(f.boundary_field["supply"]["value"])
     assert u_supply.ndim == 2 and np.all(u_supply[:, 0] < spec.wall_speed)
