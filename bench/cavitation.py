@@ -77,6 +77,10 @@ RUNS: dict[str, dict] = {
     #    release where the oil, saturated with air at ambient pressure, falls below it
     "gr_u8_8um_pr90k": {**GR, **U8, "physics.cavitation_pressure": 9e4},
     "gr_u20_T25_8um_pr90k": {**GR, **U20, "physics.cavitation_pressure": 9e4},
+    "gr_u8_8um_pr90k_k1e-4": {**GR, **U8, "physics.cavitation_pressure": 9e4,
+                              "physics.gas_release_rate": 1e-4},
+    "gr_u8_8um_pr90k_k1e-5": {**GR, **U8, "physics.cavitation_pressure": 9e4,
+                              "physics.gas_release_rate": 1e-5},
 }
 #: name -> the run whose final fields it starts from (interpolated onto its mesh): the fine level
 #: starts from the converged coarse bubble and runs 2 transits (1 to forget the start, the last

@@ -50,7 +50,12 @@ def main(argv=None) -> int:
         supply = ("flooded" if sup["mode"] == "flooded"
                   else f"layers {sup['disc_layer'] * 1e6:g}+{sup['ball_layer'] * 1e6:g} um")
         fmt = lambda v: "-" if v is None else f"{v:.2f}"  # noqa: E731
-        ax.set_title(f"u = {g.speed * 1e3:g} mm/s, {supply}, {spec['mesh']['resolution']}, "
+        scene = spec.get("scene", "interface")
+        if scene == "gas-release":
+            phys = spec["physics"]
+            scene += (f" (p_r {phys['cavitation_pressure'] * 1e-3:g} kPa, "
+                      f"k {phys['gas_release_rate']:g}/(Pa s))")
+        ax.set_title(f"{scene}: u = {g.speed * 1e3:g} mm/s, {supply}, {spec['mesh']['resolution']}, "
                      f"t = {t * 1e3:.0f} ms: "
                      f"state {m.get('state', '?')}, inlet meniscus "
                      f"{fmt(m.get('inlet_meniscus_distance_over_a'))} a "
