@@ -119,7 +119,7 @@ class Physics(BaseModel):
             the oil incompressible. A value (a mineral oil's isothermal one at ambient
             pressure is ~1.5 GPa) makes it a perfect fluid, which compressibleInterFoam does
             not transport conservatively: 10 % of the oil carried in lost over 4 transits
-            against 0.3 % incompressible (docs/cavitation.md), for a density change of
+            against 0.4 % incompressible (docs/cavitation.md), for a density change of
             4e-5 over the meshed region's 60 kPa.
     """
 

@@ -168,12 +168,13 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     # boundaries open to the air (their inletValue; the written face values of inflow faces
     # there are not what was transported)
     oil_flux_file = folder / "alphaPhi0.oil"
-    flux_bf = FoamFieldFile(oil_flux_file if oil_flux_file.exists() else folder / "phi").boundary_field
+    exact = oil_flux_file.exists()
+    flux_bf = FoamFieldFile(oil_flux_file if exact else folder / "phi").boundary_field
     alpha_bf = alpha_file.boundary_field
 
     def oil_flux(name: str, size: int) -> np.ndarray:
         flux = _uniform_or_list(flux_bf[name]["value"], size)
-        if not oil_flux_file.exists():
+        if not exact:
             flux = flux * np.clip(_uniform_or_list(alpha_bf[name]["value"], size), 0.0, 1.0)
             if name != SUPPLY_PATCH:
                 flux = np.maximum(flux, 0.0)
@@ -190,7 +191,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     pattern["min_pressure_Pa"] = _min_pressure(p, geom)
     gas = _gas(folder, alpha, p, structure, geom) if geom.absolute_pressure else {}
     return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
-                  pattern=pattern, oil_flux_exact=oil_flux_file.exists(), **gas)
+                  pattern=pattern, oil_flux_exact=exact, **gas)
 
 
 def _in_out(face_flux, structure: Structure, geom: CaseGeometry) -> tuple[float, float]:
