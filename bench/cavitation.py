@@ -45,6 +45,14 @@ SEED = {"supply.initial_bubble": 1.0}
 L3 = {"supply.disc_layer": 3e-6, "supply.ball_layer": 3e-6}
 GR = {"scene": "gas-release", "mesh.resolution": "coarse", **START}
 
+
+
+def gas_release_air_factor(conditions: dict) -> float:
+    """run.air_viscosity_factor that gives another scene the gas-release scene's air."""
+    spec = load_case_spec(ROOT / "runs" / "nominal.toml", **GR, **conditions)
+    return spec.air_viscosity / spec.physics.air_viscosity
+
+
 #: name -> overrides on runs/nominal.toml
 RUNS: dict[str, dict] = {
     # 1. 40 C, 8 mm/s
@@ -53,7 +61,12 @@ RUNS: dict[str, dict] = {
     "u8_2um": {**CAV, **U8, **THIN},
     "u8_2um_interface": {**CAV, **U8, **THIN, "scene": "interface"},
     "u8_8um_interface": {**CAV, **U8, "scene": "interface"},
+    #    interFoam with the gas-release scene's air (the oil's kinematic viscosity), to set
+    #    beside gr_u8_8um, which releases nothing
+    "u8_8um_interface_gr_air": {**CAV, **U8, "scene": "interface",
+                                "run.air_viscosity_factor": gas_release_air_factor(U8)},
     # 2. 25 C, 20 mm/s: the thesis's bubble (experiment 5 a, Reynolds model 0.9 a)
+    "u20_T25_8um": {**CAV, **U20},
     "u20_T25_8um_seed1": {**CAV, **U20, **SEED},
     "u20_T25_2um": {**CAV, **U20, **THIN},
     "u20_T25_3um": {**CAV, **U20, **L3},

@@ -214,7 +214,8 @@ class Run(BaseModel):
         capillary_safety: factor on that limit (3: with it the Courant limit, not the
             capillary one, sets the step; docs/cases.md).
         air_viscosity_factor: the air's viscosity in the solver is this times
-            physics.air_viscosity. Spurious capillary currents in the air scale as
+            physics.air_viscosity (not in the gas-release scene: :attr:`CaseSpec.air_viscosity`).
+            Spurious capillary currents in the air scale as
             sigma / mu_air and set the Courant-limited time step; 100 (the default, still
             12 times less viscous than the oil) halves the steps of the medium level
             against 20 at a measured cost of a few per cent in the flow pattern
@@ -257,8 +258,7 @@ class CaseSpec(BaseModel):
             "gas-release": incompressible oil and air, and oil below the cavitation pressure
             turns into gas at physics.gas_release_rate (interPhaseChangeFoam, Kunz's
             vaporisation term only): the gas that makes a bubble where no air reaches.
-            Experimental: interPhaseChangeFoam does not reproduce interFoam's flow even with
-            no release (docs/cavitation.md).
+            Its air has the oil's kinematic viscosity (:attr:`air_viscosity`).
         contact: the EHL conditions (:class:`ehl_precalc.spec.PrecalcSpec`).
         walls_moving: False holds both walls still (the static-meniscus test).
     """
@@ -294,6 +294,21 @@ class CaseSpec(BaseModel):
     def oil_viscosity(self) -> float:
         """Oil dynamic viscosity at ambient pressure [Pa s], times viscosity_factor."""
         return self.contact.oil().eta0 * self.physics.viscosity_factor
+
+    @property
+    def air_viscosity(self) -> float:
+        """The air's dynamic viscosity in the solver [Pa s]: physics.air_viscosity times
+        run.air_viscosity_factor; in the gas-release scene the air has the oil's kinematic
+        viscosity instead, mu_air = rho_air eta_oil / rho_oil (1.7 times the real air's at 40 C).
+
+        interPhaseChangeFoam v1912 computes the mixture's kinematic viscosity once, from the
+        initial oil fraction, and never again (the correct() of its phase-change models is
+        empty, so incompressibleTwoPhaseMixture::calcNu is not called): oil that reaches a cell
+        that started as air keeps the air's kinematic viscosity. With equal kinematic
+        viscosities the frozen field is right everywhere (docs/cavitation.md)."""
+        if self.scene == "gas-release":
+            return self.physics.air_density * self.oil_viscosity / self.oil_density
+        return self.physics.air_viscosity * self.run.air_viscosity_factor
 
     @property
     def oil_density(self) -> float:
@@ -384,7 +399,17 @@ def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> Case
     except SpecError as err:  # raised by PrecalcSpec's own validators
         raise SpecError(f"invalid case spec: contact: {err}") from None
     _check_supply_fits(spec)
+    _check_scene_options(spec)
     return spec
+
+
+def _check_scene_options(spec: CaseSpec) -> None:
+    default = Run.model_fields["air_viscosity_factor"].default
+    if spec.scene == "gas-release" and spec.run.air_viscosity_factor != default:
+        raise SpecError(
+            f"invalid case spec: run.air_viscosity_factor = {spec.run.air_viscosity_factor:g} "
+            f"does not apply to scene = \"gas-release\", whose air has the oil's kinematic "
+            f"viscosity (leave it at {default:g})")
 
 
 def _check_supply_fits(spec: CaseSpec) -> None:

@@ -115,7 +115,7 @@ def capillary_time_step(spec: CaseSpec, dx: float) -> float:
     p = spec.physics
     sigma = p.surface_tension
     rho = 0.5 * (spec.oil_density + p.air_density)
-    mu = 0.5 * (spec.oil_viscosity + p.air_viscosity * spec.run.air_viscosity_factor)
+    mu = 0.5 * (spec.oil_viscosity + spec.air_viscosity)
     kind = spec.run.capillary_limit
     if kind == "brackbill":
         dt = math.sqrt(rho * dx**3 / (2.0 * math.pi * sigma))
@@ -322,7 +322,7 @@ def _edit_transport(spec: CaseSpec, case: Path) -> None:
     with FoamFile(case / "constant" / "transportProperties") as f:
         f["oil"]["nu"] = spec.oil_viscosity / spec.oil_density
         f["oil"]["rho"] = spec.oil_density
-        f["air"]["nu"] = p.air_viscosity * spec.run.air_viscosity_factor / p.air_density
+        f["air"]["nu"] = spec.air_viscosity / p.air_density
         f["air"]["rho"] = p.air_density
         f["sigma"] = p.surface_tension
         if spec.scene == "gas-release":
@@ -361,7 +361,7 @@ def _edit_thermo(spec: CaseSpec, case: Path) -> None:
                 "rho0": spec.oil_density}
         f["mixture"]["transport"]["mu"] = spec.oil_viscosity
     with FoamFile(const / "thermophysicalProperties.air") as f:
-        f["mixture"]["transport"]["mu"] = p.air_viscosity * spec.run.air_viscosity_factor
+        f["mixture"]["transport"]["mu"] = spec.air_viscosity
         f["mixture"]["specie"]["molWeight"] = AIR_MOLAR_MASS * 1e3
 
 

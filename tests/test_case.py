@@ -51,6 +51,8 @@ def _copy(case: Path, tmp_path: Path) -> Path:
     ("[run]\nsteady_tolerance = 2.0\n", "run.steady_tolerance = 2.0", "steady_tolerance < 1"),
     ("scene = \"gas-release\"\n[physics]\ngas_release_rate = 0.0\n",
      "physics.gas_release_rate = 0.0", "0 < physics.gas_release_rate"),
+    ("scene = \"gas-release\"\n[run]\nair_viscosity_factor = 20.0\n",
+     "run.air_viscosity_factor = 20", "leave it at 100"),
 ])
 def test_bad_spec_fails_before_anything_is_written(tmp_path, table, text, expected):
     spec = tmp_path / "bad.toml"
@@ -314,13 +316,50 @@ def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
     assert m["status"] == "finished" and m["end_reason"] == "end_time", m
     assert (case / "log.interPhaseChangeFoam").read_text().rstrip().endswith("End")
     assert 0.97 * p_release < m["min_pressure_Pa"] < spec.physics.ambient_pressure
-    # all-oil supply faces (generator.case_writer.supply_faces): 0.1 % here, 5.6 % with
-    # part-oil faces, across which interPhaseChangeFoam compresses the interface
-    assert m["oil_mass_balance_error"] < 0.01
+    # all-oil supply faces (generator.case_writer.supply_faces): 1.8 % here, 5.5 % with
+    # part-oil faces, across which interPhaseChangeFoam compresses the interface. Over this
+    # 1 ms the fluxes, sampled at 15 writes, fluctuate with the air (the oil's kinematic
+    # viscosity, 60 times less than the other scenes'): interFoam with that air is off by
+    # 3.1 % here even with its exact alphaPhi0.
+    assert m["oil_mass_balance_error"] < 0.03
     assert m["oil_flux_source"] == OIL_FLUX_APPROXIMATE      # no alphaPhi0 written
     with FoamFieldFile(case / "0.orig" / "U") as f:
         u_supply = np.asarray(f.boundary_field["supply"]["value"])
     assert u_supply.ndim == 2 and np.all(u_supply[:, 0] < spec.wall_speed)
+
+
+def _last_velocity(case: Path) -> np.ndarray:
+    times = [d for d in case.iterdir() if d.is_dir() and d.name.replace(".", "").replace("e-", "").isdigit()]
+    last = max(times, key=lambda d: float(d.name))
+    return np.asarray(FoamFieldFile(last / "U").internal_field)
+
+
+def test_gas_release_flow_does_not_remember_the_initial_air(tmp_path):
+    """interPhaseChangeFoam v1912 computes the mixture viscosity once, from the initial oil
+    fraction, and never again. Here oil fills the gap and enters everywhere, so the flow must
+    not depend on whether the open boundaries start as air (the template's value) or oil. With
+    the air's kinematic viscosity 60 times the oil's (the other scenes' x100 air) the frozen
+    air viscosity on those boundaries drove 1.3 m/s across the gap; the gas-release scene's
+    air has the oil's kinematic viscosity (CaseSpec.air_viscosity), so nothing remembers."""
+    spec = make_case_spec({**SMALL, "scene": "gas-release",
+                           "run": {**SMALL["run"], "end_time": 2e-3}})
+    velocities = {}
+    for start in (0.0, 1.0):
+        case = tmp_path / f"open_boundaries_start_{start:g}"
+        write_case(spec, case)
+        with FoamFile(case / "0.orig" / "alpha.oil") as f:
+            f["internalField"] = 1.0
+            open_patches = f["boundaryField"]['"(inlet|outlet|side)"']
+            assert open_patches["value"] == 0.0
+            open_patches["inletValue"] = 1.0
+            open_patches["value"] = start
+        with FoamFile(case / "constant" / "transportProperties") as f:
+            assert f["air"]["nu"] == pytest.approx(f["oil"]["nu"])
+        m = run_case(case, wall_limit=120)
+        assert m["status"] == "finished", m.get("log_tail")
+        velocities[start] = _last_velocity(case)
+    assert np.abs(velocities[1.0]).max() > 0.5 * spec.wall_speed        # the flow is there
+    assert np.abs(velocities[0.0] - velocities[1.0]).max() < 1e-3 * spec.wall_speed
 
 
 def test_cavitating_case_starts_from_another_cases_fields(tmp_path):
