@@ -67,6 +67,7 @@ RUNS: dict[str, dict] = {
                                 "run.air_viscosity_factor": gas_release_air_factor(U8)},
     # 2. 25 C, 20 mm/s: the thesis's bubble (experiment 5 a, Reynolds model 0.9 a)
     "u20_T25_8um": {**CAV, **U20},
+    "u20_T25_8um_interface": {**CAV, **U20, "scene": "interface"},
     "u20_T25_8um_seed1": {**CAV, **U20, **SEED},
     "u20_T25_2um": {**CAV, **U20, **THIN},
     "u20_T25_3um": {**CAV, **U20, **L3},
@@ -83,7 +84,7 @@ RUNS: dict[str, dict] = {
     "gr_u8_8um": {**GR, **U8},
     "gr_u8_8um_pcav30k": {**GR, **U8, "physics.cavitation_pressure": 3e4},
     "gr_u20_T25_8um": {**GR, **U20},
-    "gr_u20_T25_8um_medium": {**GR, **U20, "mesh.resolution": "medium"},
+    "gr_u20_T25_8um_medium": {**GR, **U20, "mesh.resolution": "medium", "run.transits_max": 2.0},
     "gr_u20_T25_8um_k1e-4": {**GR, **U20, "physics.gas_release_rate": 1e-4},
     "gr_u20_T25_8um_k1e-2": {**GR, **U20, "physics.gas_release_rate": 1e-2},
     "gr_u20_T25_8um_pcav30k": {**GR, **U20, "physics.cavitation_pressure": 3e4},
@@ -94,6 +95,11 @@ RUNS: dict[str, dict] = {
                               "physics.gas_release_rate": 1e-4},
     "gr_u8_8um_pr90k_k1e-5": {**GR, **U8, "physics.cavitation_pressure": 9e4,
                               "physics.gas_release_rate": 1e-5},
+    "gr_u8_8um_pr90k_k1e-2": {**GR, **U8, "physics.cavitation_pressure": 9e4,
+                              "physics.gas_release_rate": 1e-2},
+    "gr_u8_8um_pr60k": {**GR, **U8, "physics.cavitation_pressure": 6e4},
+    "gr_u8_8um_pr90k_medium": {**GR, **U8, "physics.cavitation_pressure": 9e4,
+                               "mesh.resolution": "medium", "run.transits_max": 3.0},
 }
 #: name -> the run whose final fields it starts from (interpolated onto its mesh): the fine level
 #: starts from the converged coarse bubble and runs 2 transits (1 to forget the start, the last
@@ -173,7 +179,10 @@ def main(argv=None) -> int:
     out = RESULTS / "cavitation.json"
     old = json.loads(out.read_text())["rows"] if out.is_file() else []
     merged = {r["name"]: r for r in old} | {r["name"]: r for r in rows}
-    atomic_write_json(out, {"rows": [merged[n] for n in RUNS if n in merged]})
+    # rows in RUNS order, then any this copy of RUNS does not know (another process, started
+    # after a run was added, may have written them meanwhile)
+    order = [n for n in RUNS if n in merged] + [n for n in merged if n not in RUNS]
+    atomic_write_json(out, {"rows": [merged[n] for n in order]})
     fmt = lambda v: f"{v:.4g}" if isinstance(v, float) else str(v)  # noqa: E731
     head = ("name", "state", "bubble_length_over_a", "bubble_enclosed", "min_pressure_Pa",
             "oil_mass_balance_error", "end_reason", "cells", "cpu_s")
