@@ -85,6 +85,7 @@ RUNS: dict[str, dict] = {
     "gr_u8_8um_pcav30k": {**GR, **U8, "physics.cavitation_pressure": 3e4},
     "gr_u20_T25_8um": {**GR, **U20},
     "gr_u20_T25_8um_medium": {**GR, **U20, "mesh.resolution": "medium", "run.transits_max": 2.0},
+    "gr_u20_T25_8um_fine": {**GR, **U20, "mesh.resolution": "fine", "run.transits_max": 1.5},
     "gr_u20_T25_8um_k1e-4": {**GR, **U20, "physics.gas_release_rate": 1e-4},
     "gr_u20_T25_8um_k1e-2": {**GR, **U20, "physics.gas_release_rate": 1e-2},
     "gr_u20_T25_8um_pcav30k": {**GR, **U20, "physics.cavitation_pressure": 3e4},
