@@ -46,7 +46,6 @@ L3 = {"supply.disc_layer": 3e-6, "supply.ball_layer": 3e-6}
 GR = {"scene": "gas-release", "mesh.resolution": "coarse", **START}
 
 
-
 def gas_release_air_factor(conditions: dict) -> float:
     """run.air_viscosity_factor that gives another scene the gas-release scene's air."""
     spec = load_case_spec(ROOT / "runs" / "nominal.toml", **GR, **conditions)

@@ -20,6 +20,7 @@ from foamlib import FoamFieldFile, FoamFile
 from ehl_precalc.spec import SpecError
 from generator.case_spec import make_case_spec
 from generator.case_writer import CaseExists, capillary_time_step, load_geometry, write_case
+from runs import case_fields
 from runs.foam_runtime import FoamRuntime
 from runs.run_case import OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, run_case
 from tiny import SMALL
@@ -329,8 +330,7 @@ def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
 
 
 def _last_velocity(case: Path) -> np.ndarray:
-    times = [d for d in case.iterdir() if d.is_dir() and d.name.replace(".", "").replace("e-", "").isdigit()]
-    last = max(times, key=lambda d: float(d.name))
+    _, last = case_fields.time_folders(case)[-1]
     return np.asarray(FoamFieldFile(last / "U").internal_field)
 
 
