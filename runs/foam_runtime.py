@@ -74,6 +74,8 @@ EMBEDDED_LIB_DIRS: tuple[str, ...] = (
     "lib/x86_64-linux-gnu",
 )
 DEFAULT_NATIVE_PROJECT_DIR = "/usr/share/openfoam"
+#: mpirun and the options every parallel run gets (see FoamRuntime.mpi_command).
+MPIRUN: tuple[str, ...] = ("mpirun", "--oversubscribe", "--bind-to", "none")
 
 #: A build passes the pitzDaily check when its error is below this.
 #: Good build (Debian 13, 1912.200626-3+b1): 1.14e-4; broken Debian 12 build: 1218.37.
@@ -213,7 +215,10 @@ class FoamRuntime:
                     *args: str) -> list[str]:
         """The argv that runs ``app -parallel`` on ``n_procs`` MPI ranks in ``case``.
 
-        native/prefix: ``mpirun --oversubscribe -np N <command> -parallel`` (the user's mpirun).
+        native/prefix: ``mpirun --oversubscribe --bind-to none -np N <command> -parallel`` (the
+        user's mpirun). ``--bind-to none``: Open MPI binds the ranks of every mpirun to the
+        first cores by default, so cases run side by side (a batch, ``--jobs``) would share
+        the same cores and leave the others idle.
         embedded: Debian 13's mpirun cannot be driven through the loader, so the run happens
         in a chroot of the runtime, in a private mount namespace (``unshare -m``) where the
         case is bind-mounted at ``/mnt``; the mounts vanish with the process. Needs root.
@@ -222,7 +227,7 @@ class FoamRuntime:
         if n_procs < 2:
             raise FoamConfigError(f"n_procs = {n_procs}: an MPI run needs at least 2 ranks")
         if self.kind != "embedded":
-            return ["mpirun", "--oversubscribe", "-np", str(n_procs),
+            return [*MPIRUN, "-np", str(n_procs),
                     *self.command(app, *args), "-parallel"]
         if os.geteuid() != 0:
             raise FoamConfigError(
@@ -232,7 +237,7 @@ class FoamRuntime:
         allow = " ".join(f"{k}=1" for k in (
             "OMPI_ALLOW_RUN_AS_ROOT", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM",
             "PRTE_ALLOW_RUN_AS_ROOT", "PRTE_ALLOW_RUN_AS_ROOT_CONFIRM"))
-        inner = shlex.join(["mpirun", "--oversubscribe", "-np", str(n_procs), app, *args,
+        inner = shlex.join([*MPIRUN, "-np", str(n_procs), app, *args,
                             "-parallel"])
         script = (f"mount --bind {shlex.quote(str(case))} {shlex.quote(str(root / 'mnt'))} && "
                   f"mount -t proc proc {shlex.quote(str(root / 'proc'))} && "
