@@ -39,9 +39,10 @@ def summarise(case: str | Path) -> dict:
     opened = next((ti for ti, r in zip(t, rows) if r["state"] == "II"), None)
     last = [r for ti, r in zip(t, rows) if ti >= t[-1] - transit * (1 + 1e-9)]
     window = {}
-    for key in TRACKED:
-        v = [float(r[key]) for r in last]
-        window[key] = {"mean": sum(v) / len(v), "min": min(v), "max": max(v), "n": len(v)}
+    for key in TRACKED:   # an empty value: not found at that write (the meniscus at the edge)
+        v = [float(r[key]) for r in last if r[key] != ""]
+        window[key] = ({"mean": sum(v) / len(v), "min": min(v), "max": max(v), "n": len(v)}
+                       if v else None)
     v0 = float(last[0]["oil_volume_m3"])
     span = (float(last[-1]["time_s"]) - float(last[0]["time_s"])) / transit
     return {
@@ -83,7 +84,8 @@ def main(argv=None) -> int:
               f"{r['time_steps']} steps, {r['wall_s']:.0f} s wall, end {r['end_reason']}; "
               f"states {r['states_per_write']}; first open {opened}")
         print("   last transit: " + ", ".join(
-            f"{k} {v['mean']:.4g} ({v['min']:.4g}-{v['max']:.4g})" for k, v in w.items())
+            f"{k} {v['mean']:.4g} ({v['min']:.4g}-{v['max']:.4g}, {v['n']} writes)" if v
+            else f"{k} not found" for k, v in w.items())
             + f"; oil volume drift {r['oil_volume_drift_per_transit']:+.2%}/transit, "
               f"out/in {r['outflow_over_inflow_last']:.3f}")
     if args.save:

@@ -1,11 +1,11 @@
 """Flow pattern against the oil supply at two speeds (state I / II, inlet meniscus shape).
 
     python bench/supply_sweep.py [--speeds 0.008 0.017] [--layers 0.5e-6 1e-6 2e-6 4e-6]
-        [--flooded] [--level coarse] [--jobs 2]
+        [--flooded] [--level coarse] [--jobs 2] [--work DIR] [--tag _SUFFIX]
 
 Each case: the reference contact (HVI60, 40 C, 20 N) at the speed, oil layers of the given
 thickness on disc and ball over a track of half-width --track, run to steady state or
---transits transit times. Writes ``bench/results/supply_sweep_<level>.json`` and a table.
+--transits transit times. Writes ``bench/results/supply_sweep_<level><tag>.json`` and a table.
 """
 
 from __future__ import annotations
@@ -64,13 +64,14 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--rerun", action="store_true", help="recompute finished cases")
     ap.add_argument("--work", default=str(ROOT / "runs" / "bench" / "supply_sweep"))
+    ap.add_argument("--tag", default="", help="suffix of the results file (keeps earlier ones)")
     args = ap.parse_args(argv)
     layers = list(args.layers) + (["flooded"] if args.flooded else [])
     jobs = [(s, lay, args) for s, lay in itertools.product(args.speeds, layers)]
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         rows = list(pool.map(one, jobs))
     RESULTS.mkdir(parents=True, exist_ok=True)
-    out = RESULTS / f"supply_sweep_{args.level}.json"
+    out = RESULTS / f"supply_sweep_{args.level}{args.tag}.json"
     out.write_text(json.dumps({"args": {k: v for k, v in vars(args).items()}, "rows": rows},
                               indent=2, default=str) + "\n")
     head = ("speed_m_s", "layer_m", "state", "inlet_meniscus_distance_over_a",

@@ -23,7 +23,7 @@ units of the Hertzian radius a::
     ...
 
     [domain]             # units of a
-    upstream = 8.0
+    upstream = 12.0
     ...
 
     [mesh]
@@ -141,7 +141,9 @@ class Domain(BaseModel):
     """Extents around the contact centre, units of the Hertzian radius a.
 
     Attributes:
-        upstream: distance to the inlet boundary (x = -upstream a).
+        upstream: distance to the inlet boundary (x = -upstream a). 12 a: with ample oil
+            (8 um layers at 8 mm/s) the inlet meniscus sits 6-6.6 a upstream of x = -a, and
+            at 8 a it touched the boundary (docs/cases.md, "The upstream boundary leaked oil").
         downstream: distance to the outlet boundary.
         side: distance to the side boundary (|y| = side a).
         island_radius: radius of the island wall that replaces the Hertzian contact
@@ -150,7 +152,7 @@ class Domain(BaseModel):
     """
 
     model_config = _STRICT
-    upstream: float = Field(8.0, gt=1.0, le=200.0)
+    upstream: float = Field(12.0, gt=1.0, le=200.0)
     downstream: float = Field(14.0, gt=1.0, le=200.0)
     side: float = Field(8.0, gt=1.0, le=200.0)
     island_radius: float = Field(1.5, gt=1.0, le=10.0)

@@ -244,8 +244,9 @@ def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, fraction: np.ndarra
         if len(supply):
             f.boundary_field["supply"]["value"] = (supply if len(supply) not in (3, 6, 9)
                                                    else _PLACEHOLDER)
-        if spec.scene == "single-phase":
-            f.boundary_field['"(inlet|outlet|side)"']["inletValue"] = 1.0
+        if spec.scene == "single-phase":   # oil everywhere: oil is what flows in
+            f.boundary_field['"(outlet|side)"']["inletValue"] = 1.0
+            f.boundary_field["inlet"]["value"] = 1.0
         if not geom.symmetric:
             del f.boundary_field["symmetry"]
     if len(supply) in (3, 6, 9):

@@ -246,6 +246,12 @@ def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     assert m["oil_mass_balance_error"] is not None and m["oil_mass_balance_error"] < 0.1
     assert m["oil_flux_source"] == OIL_FLUX_EXACT
     assert m["oil_inflow_m3_s"] == pytest.approx(0.02 * 6e-6 * 5e-4, rel=1e-6)
+    # the upstream boundary takes air in and lets no oil out (its alpha is fixed: with
+    # inletOutlet the flickering face flux pumped oil out there, docs/cases.md)
+    last = case_fields.time_folders(case)[-1][1]
+    oil_up = FoamFieldFile(last / "alphaPhi0.oil").boundary_field["inlet"]["value"]
+    assert np.all(np.asarray(oil_up) == 0.0)
+    assert np.sum(FoamFieldFile(last / "phi").boundary_field["inlet"]["value"]) < 0
     rows = (case / "history.csv").read_text().splitlines()
     assert len(rows) >= 10 and rows[0].startswith("time_s,oil_volume_m3")
     saved = json.loads((case / "metrics.json").read_text())
@@ -337,7 +343,8 @@ def _last_velocity(case: Path) -> np.ndarray:
 def test_gas_release_flow_does_not_remember_the_initial_air(tmp_path):
     """interPhaseChangeFoam v1912 computes the mixture viscosity once, from the initial oil
     fraction, and never again. Here oil fills the gap and enters everywhere, so the flow must
-    not depend on whether the open boundaries start as air (the template's value) or oil. With
+    not depend on whether the outlet and side boundaries start as air (the template's value)
+    or oil. With
     the air's kinematic viscosity 60 times the oil's (the other scenes' x100 air) the frozen
     air viscosity on those boundaries drove 1.3 m/s across the gap; the gas-release scene's
     air has the oil's kinematic viscosity (CaseSpec.air_viscosity), so nothing remembers."""
@@ -349,10 +356,11 @@ def test_gas_release_flow_does_not_remember_the_initial_air(tmp_path):
         write_case(spec, case)
         with FoamFile(case / "0.orig" / "alpha.oil") as f:
             f["internalField"] = 1.0
-            open_patches = f["boundaryField"]['"(inlet|outlet|side)"']
+            open_patches = f["boundaryField"]['"(outlet|side)"']
             assert open_patches["value"] == 0.0
             open_patches["inletValue"] = 1.0
             open_patches["value"] = start
+            f["boundaryField"]["inlet"]["value"] = 1.0       # fixed: oil enters there too
         with FoamFile(case / "constant" / "transportProperties") as f:
             assert f["air"]["nu"] == pytest.approx(f["oil"]["nu"])
         m = run_case(case, wall_limit=120)
@@ -493,3 +501,18 @@ def test_cli_run_prints_metrics_and_exit_code(small_case, tmp_path):
     busy = subprocess.run([*EHLFOAM, "run", str(tmp_path / "nowhere")], capture_output=True,
                           text=True)
     assert busy.returncode == 2 and "nowhere" in busy.stderr
+
+
+def test_single_phase_case_stays_oil(tmp_path):
+    """The single-phase scene (oil everywhere, the Reynolds check): oil is what enters on
+    every open boundary, the fixed upstream one included, so no air appears in 1 ms."""
+    case = tmp_path / "single"
+    write_case(make_case_spec({**SMALL, "scene": "single-phase"}), case)
+    with FoamFile(case / "0.orig" / "alpha.oil") as f:
+        assert f["boundaryField"]["inlet"]["value"] == 1.0
+        assert f["boundaryField"]['"(outlet|side)"']["inletValue"] == 1.0
+    m = run_case(case, wall_limit=120)
+    assert m["status"] == "finished", m.get("log_tail")
+    last = case_fields.time_folders(case)[-1][1]
+    alpha = np.asarray(FoamFieldFile(last / "alpha.oil").internal_field, dtype=float)
+    assert alpha.min() > 0.999
