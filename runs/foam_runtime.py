@@ -216,9 +216,9 @@ class FoamRuntime:
         """The argv that runs ``app -parallel`` on ``n_procs`` MPI ranks in ``case``.
 
         native/prefix: ``mpirun --oversubscribe --bind-to none -np N <command> -parallel`` (the
-        user's mpirun). ``--bind-to none``: Open MPI binds the ranks of every mpirun to the
-        first cores by default, so cases run side by side (a batch, ``--jobs``) would share
-        the same cores and leave the others idle.
+        user's mpirun). ``--bind-to none``: by default Open MPI binds a small run's ranks to
+        cores counted from the first, for every mpirun alike, so cases run side by side (a
+        batch, ``--jobs``) would share those cores and leave the others idle.
         embedded: Debian 13's mpirun cannot be driven through the loader, so the run happens
         in a chroot of the runtime, in a private mount namespace (``unshare -m``) where the
         case is bind-mounted at ``/mnt``; the mounts vanish with the process. Needs root.

@@ -344,10 +344,10 @@ def test_gas_release_flow_does_not_remember_the_initial_air(tmp_path):
     """interPhaseChangeFoam v1912 computes the mixture viscosity once, from the initial oil
     fraction, and never again. Here oil fills the gap and enters everywhere, so the flow must
     not depend on whether the outlet and side boundaries start as air (the template's value)
-    or oil. With
-    the air's kinematic viscosity 60 times the oil's (the other scenes' x100 air) the frozen
-    air viscosity on those boundaries drove 1.3 m/s across the gap; the gas-release scene's
-    air has the oil's kinematic viscosity (CaseSpec.air_viscosity), so nothing remembers."""
+    or oil. With the air's kinematic viscosity 60 times the oil's (the other scenes' x100 air)
+    the frozen air viscosity on those boundaries drove 1.3 m/s across the gap; the
+    gas-release scene's air has the oil's kinematic viscosity (CaseSpec.air_viscosity), so
+    nothing remembers."""
     spec = make_case_spec({**SMALL, "scene": "gas-release",
                            "run": {**SMALL["run"], "end_time": 2e-3}})
     velocities = {}
