@@ -9,23 +9,20 @@ min and max over the last transit of the flow-pattern metrics and the oil volume
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 from pathlib import Path
 
+import numpy as np
+
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import RESULTS, save  # noqa: E402
+from runs.report.case_data import read_history  # noqa: E402
 
 #: history.csv columns summarised over the last transit.
 TRACKED = ("inlet_meniscus_distance_over_a", "flooded_length_over_a", "flooded_width_over_a",
            "bubble_length_over_a", "oil_volume_m3")
-
-
-def _rows(case: Path) -> list[dict]:
-    with open(case / "history.csv", newline="") as fh:
-        return list(csv.DictReader(fh))
 
 
 def summarise(case: str | Path) -> dict:
@@ -33,39 +30,39 @@ def summarise(case: str | Path) -> dict:
     case = Path(case)
     metrics = json.loads((case / "metrics.json").read_text())
     transit = metrics["transit_time_s"]
-    rows = _rows(case)
-    t = [float(r["time_s"]) for r in rows]
-    states = [r["state"] for r in rows]
-    opened = next((ti for ti, r in zip(t, rows) if r["state"] == "II"), None)
-    last = [r for ti, r in zip(t, rows) if ti >= t[-1] - transit * (1 + 1e-9)]
+    h = read_history(case / "history.csv")
+    t, states = h["time_s"], [str(x) for x in h["state"]]
+    opened = next((float(ti) for ti, st in zip(t, states) if st == "II"), None)
+    last = t >= t[-1] - transit * (1 + 1e-9)
     window = {}
-    for key in TRACKED:   # an empty value: not found at that write (the meniscus at the edge)
-        v = [float(r[key]) for r in last if r[key] != ""]
-        window[key] = ({"mean": sum(v) / len(v), "min": min(v), "max": max(v), "n": len(v)}
-                       if v else None)
-    v0 = float(last[0]["oil_volume_m3"])
-    span = (float(last[-1]["time_s"]) - float(last[0]["time_s"])) / transit
+    for key in TRACKED:   # NaN: not found at that write (the meniscus at the edge)
+        v = h[key][last]
+        v = v[np.isfinite(v)]
+        window[key] = ({"mean": float(v.mean()), "min": float(v.min()), "max": float(v.max()),
+                        "n": int(v.size)} if v.size else None)
+    volume, t_last = h["oil_volume_m3"][last], t[last]
+    span = (t_last[-1] - t_last[0]) / transit
+    in_last, out_last = h["oil_in_m3_s"][-1], h["oil_out_m3_s"][-1]
+    enclosed = (np.array(states)[last] == "I") & (h["bubble_length_over_a"][last] > 0)
     return {
         "case": case.name,
         "cells": metrics.get("cells"),
         "time_steps": metrics.get("time_steps"),
         "wall_s": metrics.get("wall_s"),
         "end_reason": metrics.get("end_reason"),
-        "t_first_s": t[0], "t_last_s": t[-1],
-        "transits_written": (t[-1] - t[0]) / transit,
+        "t_first_s": float(t[0]), "t_last_s": float(t[-1]),
+        "transits_written": float(t[-1] - t[0]) / transit,
         "states_per_write": " ".join(states),
-        "state_last": rows[-1]["state"],
+        "state_last": states[-1],
         "writes_state_I": states.count("I"),
-        "writes": len(rows),
+        "writes": len(states),
         "first_open_s": opened,
         "first_open_transits": None if opened is None else opened / transit,
-        "bubble_enclosed_last_transit": sum(r["state"] == "I" and float(r["bubble_length_over_a"]) > 0
-                                            for r in last) / len(last),
+        "bubble_enclosed_last_transit": float(enclosed.mean()),
         "last_transit": window,
-        "oil_volume_drift_per_transit": ((float(last[-1]["oil_volume_m3"]) - v0) / v0 / span
+        "oil_volume_drift_per_transit": (float((volume[-1] - volume[0]) / volume[0] / span)
                                          if span > 0 else None),
-        "outflow_over_inflow_last": (float(rows[-1]["oil_out_m3_s"]) / float(rows[-1]["oil_in_m3_s"])
-                                     if float(rows[-1]["oil_in_m3_s"]) > 0 else None),
+        "outflow_over_inflow_last": float(out_last / in_last) if in_last > 0 else None,
     }
 
 
