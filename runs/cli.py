@@ -81,6 +81,16 @@ def parse_value(text: str):
         return text
 
 
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{value} (valid range > 0)")
+    return value
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     """Run a generated case and print its metrics."""
     import json
@@ -104,7 +114,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     try:
         with progress:
-            metrics = run_case(args.case, wall_limit=args.wall_limit, on_sample=on_sample)
+            metrics = run_case(args.case, wall_limit=args.wall_limit, on_sample=on_sample,
+                               extend_transits=args.extend)
     except (CaseBusy, FileNotFoundError) as err:
         print(f"ehlfoam run: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -169,6 +180,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("case", help="case folder written by `ehlfoam case`")
     run.add_argument("--wall-limit", type=float, default=None,
                      help="wall-clock limit [s] (default: the spec's run.wall_limit)")
+    run.add_argument("--extend", type=_positive_float, default=None, metavar="TRANSITS",
+                     help="go on for TRANSITS transit times past the latest written time, "
+                          "whatever the steady-state tests say (does a steady state last?)")
     run.add_argument("--quiet", action="store_true", help="no line per written time")
     run.set_defaults(func=cmd_run)
 

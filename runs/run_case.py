@@ -220,11 +220,18 @@ def mass_balance(history: list[case_fields.Sample]) -> dict:
 
 def run_case(case: str | Path, runtime: FoamRuntime | None = None,
              wall_limit: float | None = None,
-             on_sample: Callable[[case_fields.Sample, CaseGeometry], None] | None = None) -> dict:
+             on_sample: Callable[[case_fields.Sample, CaseGeometry], None] | None = None,
+             extend_transits: float | None = None) -> dict:
     """Run the case in ``case`` to steady state (or a limit) and write ``metrics.json``.
 
-    Restarts from the latest written time if the case ran before. Returns the metrics dict.
+    Restarts from the latest written time if the case ran before. With ``extend_transits``
+    the run goes on for that many transit times past the latest written time whatever the
+    steady-state tests say (to see whether a steady state lasts, or to go on after a time
+    limit); it then ends at ``end_time``, the wall limit or divergence. Returns the metrics
+    dict.
     """
+    if extend_transits is not None and not extend_transits > 0:
+        raise ValueError(f"extend_transits = {extend_transits!r} transits: it must be > 0")
     case = Path(case).absolute()
     spec, geom = load_spec_of(case), load_geometry(case)
     structure = case_fields.Structure.load(case)
@@ -236,12 +243,25 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
     except BlockingIOError:
         raise CaseBusy(f"case {case} is being run by another process") from None
     try:
-        return _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample)
+        if extend_transits is not None:
+            _extend_end_time(case, geom, extend_transits)
+        return _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample,
+                           check_steady=extend_transits is None)
     finally:
         lock.close()
 
 
-def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> dict:
+def _extend_end_time(case: Path, geom: CaseGeometry, transits: float) -> None:
+    """Set controlDict's endTime ``transits`` transit times past the latest written time."""
+    folders = case_fields.time_folders(case)
+    if not folders:
+        raise FileNotFoundError(f"{case} has no written time to extend: run it first")
+    with FoamFile(case / "system" / "controlDict") as f:
+        f["endTime"] = folders[-1][0] + transits * geom.transit_time
+
+
+def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample,
+                check_steady: bool = True) -> dict:
     atomic_write_json(case / "metrics.json", {"status": "running", "cells": geom.cells})
     if not (case / "0").is_dir():
         shutil.copytree(case / "0.orig", case / "0")
@@ -275,8 +295,9 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample) -> 
             if exited:
                 break
             if reason is None:
-                passed = steady_test(history, geom.transit_time, spec.run.steady_tolerance,
-                                     spec.run.transit_length)
+                passed = check_steady and steady_test(
+                    history, geom.transit_time, spec.run.steady_tolerance,
+                    spec.run.transit_length)
                 if passed:
                     reason, steady_kind = "steady", passed
                 elif time.monotonic() - t_start > wall_limit:

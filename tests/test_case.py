@@ -484,6 +484,13 @@ def test_monitor_stops_a_steady_run(tmp_path):
     assert m["status"] == "finished" and m["end_reason"] == "steady" and m["steady"], m
     assert m["simulated_time_s"] < 0.5 * spec.end_time
     assert FoamFile(case / "system" / "controlDict")["stopAt"] == "writeNow"
+    # --extend: two more transits past the stop, whatever the steady tests say
+    t_stop, transit = m["simulated_time_s"], m["transit_time_s"]
+    e = run_case(case, wall_limit=300, extend_transits=2.0)
+    assert e["status"] == "finished" and e["end_reason"] == "end_time" and not e["steady"], e
+    assert e["simulated_time_s"] == pytest.approx(t_stop + 2.0 * transit, rel=1e-3)
+    with pytest.raises(ValueError, match="extend_transits = 0"):
+        run_case(case, extend_transits=0)
 
 
 def test_cli_run_prints_metrics_and_exit_code(small_case, tmp_path):
@@ -501,6 +508,9 @@ def test_cli_run_prints_metrics_and_exit_code(small_case, tmp_path):
     busy = subprocess.run([*EHLFOAM, "run", str(tmp_path / "nowhere")], capture_output=True,
                           text=True)
     assert busy.returncode == 2 and "nowhere" in busy.stderr
+    bad = subprocess.run([*EHLFOAM, "run", str(case), "--extend", "-1"], capture_output=True,
+                         text=True)
+    assert bad.returncode == 2 and "--extend" in bad.stderr and "> 0" in bad.stderr
 
 
 def test_single_phase_case_stays_oil(tmp_path):
