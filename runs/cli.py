@@ -59,11 +59,25 @@ def cmd_case(args: argparse.Namespace) -> int:
     except (SpecError, ValueError) as err:
         print(f"ehlfoam case: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if args.start_from:
+        from runs.ramp import RampError, final_time
+
+        try:   # before anything is written
+            final_time(args.start_from)
+        except (RampError, FileNotFoundError) as err:
+            print(f"ehlfoam case: --start-from {args.start_from}: {err}", file=sys.stderr)
+            return EXIT_BAD_INPUT
     try:
         geom = write_case(spec, args.out, overwrite=args.overwrite)
     except CaseExists as err:
         print(f"ehlfoam case: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if args.start_from:
+        from runs.ramp import seed_from_previous
+
+        seed = seed_from_previous(args.out, args.start_from)
+        print(f"starts from {args.start_from} at t = {seed['previous_time_s']:.4g} s "
+              f"({seed['method']}: {', '.join(seed['fields'])})")
     print(f"case {args.out}: {geom.solver}, {geom.cells} cells, a = {geom.a * 1e3:.4f} mm, "
           f"transit {geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, "
           f"maxDeltaT {geom.max_delta_t:.3g} s ({geom.capillary_limit}), "
@@ -170,6 +184,10 @@ def build_parser() -> argparse.ArgumentParser:
                       help="override a spec value, e.g. --set contact.speed=0.017 "
                            "--set mesh.resolution=coarse (repeatable)")
     case.add_argument("--overwrite", action="store_true", help="replace an existing case")
+    case.add_argument("--start-from", default=None, metavar="CASE",
+                      help="start from the final fields of another run case (a converged "
+                           "neighbour: another speed, supply or level), copied on the same "
+                           "mesh, else interpolated")
     case.set_defaults(func=cmd_case)
 
     run = sub.add_parser(

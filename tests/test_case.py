@@ -389,6 +389,42 @@ def test_cavitating_case_starts_from_another_cases_fields(tmp_path):
         json.loads((first / "metrics.json").read_text())["oil_volume_m3"], rel=1e-6)
 
 
+def _toml(spec: dict) -> str:
+    """A spec dict (scalars and one level of tables) as TOML."""
+    top = [f"{k} = {json.dumps(v)}" for k, v in spec.items() if not isinstance(v, dict)]
+    tables = [f"[{k}]\n" + "\n".join(f"{kk} = {json.dumps(vv)}" for kk, vv in v.items())
+              for k, v in spec.items() if isinstance(v, dict)]
+    return "\n".join(top + tables) + "\n"
+
+
+def test_cli_case_starts_from_another_run_case(tmp_path):
+    """`ehlfoam case --start-from CASE`: the new case's initial fields are CASE's final ones
+    (a converged neighbour); a CASE with nothing written is refused before anything is."""
+    spec = tmp_path / "small.toml"
+    spec.write_text(_toml({**SMALL, "run": {**SMALL["run"], "end_time": 2e-4}}))
+    first, second = tmp_path / "first", tmp_path / "second"
+    assert subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(first)],
+                          capture_output=True).returncode == 0
+    refused = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(second),
+                              "--start-from", str(first)], capture_output=True, text=True)
+    assert refused.returncode == 2 and "no written time" in refused.stderr
+    assert not second.exists()
+    assert run_case(first, wall_limit=120)["status"] == "finished"
+    proc = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(second), "--start-from",
+                           str(first), "--set", "contact.speed=0.025"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "starts from" in proc.stdout
+    t, folder = case_fields.time_folders(first)[-1]
+    info = json.loads((second / "ehlfoam" / "ramp.json").read_text())
+    assert info["method"] == "copy" and info["previous_time_s"] == pytest.approx(t)
+    structure = case_fields.Structure.load(second)
+    final = case_fields._read_alpha(folder / "alpha.oil", structure)[0]
+    start = case_fields._read_alpha(second / "0.orig" / "alpha.oil", structure)[0]
+    assert np.allclose(start, final) and not np.allclose(
+        start, case_fields._read_alpha(first / "0.orig" / "alpha.oil", structure)[0])
+
+
 def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:   # a fixed, absurd time step
