@@ -124,6 +124,9 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
                     raise RuntimeError(f"the previous ramp step {previous.name} is not "
                                        f"finished ({case_status(previous)})")
                 seed = seed_from_previous(case, previous)
+            elif pc.ramp and pc.ramp.get("start_from"):   # the first step, from a run case
+                stage = "ramp start"
+                seed = seed_from_previous(case, pc.ramp["start_from"])
             build_s = time.monotonic() - t0
             stage = "run"
             metrics = run_case(case)

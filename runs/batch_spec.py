@@ -30,6 +30,8 @@ cases under ``runs/NAME/``)::
     temperature_C = 40
     load_N = 20
     resolution = "coarse"
+    start_from = "runs/u8"             # optional: the first step starts from this run
+                                       # case's final fields (a converged state)
 
 A dimension not swept takes the base's value. Units: mm/s, um, N and C in this file only;
 everything inside is SI. Every expanded case is validated by the case spec itself
@@ -245,12 +247,16 @@ class Ramp(BaseModel):
         branches: "up-down" (up, then back down without repeating the top speed), "up",
             "down" (the speeds from the top) or "down-up".
         temperature_C, load_N, supply, resolution: single values (default: the base's).
+        start_from: a run case folder (absolute, or relative to where the batch is started)
+            whose final fields the first step starts from: a converged state to step the
+            speed up from, instead of the standard start (the puddle).
     """
 
     model_config = _STRICT
     name: str = Field(pattern=r"^[A-Za-z0-9]{1,16}$")
     speed_mm_s: Annotated[list[float], BeforeValidator(_ramp_speeds)]
     branches: Literal["up-down", "up", "down", "down-up"] = "up-down"
+    start_from: str | None = None
     temperature_C: OneNumber | None = None
     load_N: OneNumber | None = None
     supply: OneSupply | None = None
@@ -444,6 +450,15 @@ def _check_values(batch: BatchSpec, base: CaseSpec) -> None:
                                {dotted: getattr(r, key)}))
         if r.supply is not None:
             checks.append((f"{where} supply = {r.supply.label!r}", r.supply.overrides()))
+    for r in batch.ramp:
+        if r.start_from:
+            from .case_fields import time_folders
+
+            folder = Path(r.start_from)
+            if not folder.is_dir() or not time_folders(folder):
+                raise SpecError(f"invalid batch spec: ramp {r.name!r} start_from = "
+                                f"{r.start_from!r}: not a case folder with a written time "
+                                f"(give a case that has run)")
     for where, overrides in checks:
         try:
             _case_spec(batch.base, "check", overrides)
@@ -479,6 +494,8 @@ def expand(batch: BatchSpec) -> list[PlannedCase]:
         for step, (u, direction) in enumerate(r.steps(), start=1):
             p = _params(u, T, F, s, res)
             ramp = {"name": r.name, "step": step, "direction": direction, "previous": previous}
+            if step == 1 and r.start_from:
+                ramp["start_from"] = str(Path(r.start_from).absolute())
             previous = _add(plan, batch, p, s, ramp)
     return list(plan.values())
 

@@ -195,6 +195,29 @@ def test_ramp_start_on_another_mesh_is_interpolated(tiny, tmp_path):
     assert seeded == pytest.approx(final, rel=0.25, abs=0)
 
 
+def test_ramp_starts_from_a_run_case(tiny, tmp_path, capsys):
+    """``start_from``: the ramp's first step starts from a case that ran elsewhere (here a
+    finished step of the tiny batch), not from the puddle; a folder that has not run is
+    refused before anything is built."""
+    source = tiny[1].batch_dir / CASES / RAMP[1]
+    ramp = "[[ramp]]\nname = \"S\"\nspeed_mm_s = [15, 25]\nbranches = \"up\"\n"
+    bad = _spec(tmp_path, "bad", BASE + ramp + f"start_from = \"{tmp_path}\"\n")
+    assert batch_cli.main([str(bad), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "ramp 'S' start_from = " in err and "not a case folder with a written time" in err
+    assert not (tmp_path / "bad").exists()
+    spec = _spec(tmp_path, "from_run", BASE + ramp + f"start_from = \"{source}\"\n")
+    outcome = run_batch(spec, BatchOptions(jobs=1, quiet=True, report=False))
+    assert outcome.exit_code == 0
+    case = outcome.batch_dir / CASES / "rampS_up01_u15.0_s3um_T40_F20_coarse"
+    info = json.loads((case / "ehlfoam" / "ramp.json").read_text())
+    assert (case / info["previous"]).resolve() == source.resolve() and info["method"] == "copy"
+    m = json.loads((case / "metrics.json").read_text())
+    assert m["ramp_start_method"] == "copy"
+    assert m["oil_volume_initial_m3"] == pytest.approx(
+        json.loads((source / "metrics.json").read_text())["oil_volume_m3"], rel=1e-3, abs=0)
+
+
 def test_rerun_keeps_finished_and_failed_cases(tiny):
     spec, outcome = tiny
     before = _mtimes(outcome.batch_dir)
