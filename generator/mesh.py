@@ -300,15 +300,23 @@ def _sample_size(params: MeshParams, size: SizeFunction) -> tuple[float, float, 
     return float(S.min()), float(S.max()), estimate, even
 
 
-def _size_callback(size: SizeFunction, fallback: float, errors: list[str]):
+def _size_callback(size: SizeFunction, fallback: float, errors: list[str],
+                   interrupts: list[BaseException] | None = None):
     """gmsh size callback calling ``size`` on one point (np.float64 scalars).
 
     Problems are recorded in ``errors`` (raising through gmsh's C code is
     not possible); the mesher then gets ``fallback`` so that it ends fast.
+    A Ctrl-C or stop signal arriving in the callback (KeyboardInterrupt) is
+    kept in ``interrupts`` for the caller to raise once gmsh has returned:
+    ctypes would swallow it and hand gmsh a size of 0, a broken mesh.
     """
     def callback(dim: int, tag: int, x: float, y: float, z: float, lc: float) -> float:
         try:
             value = float(np.asarray(size(np.float64(x), np.float64(y)), dtype=float).reshape(-1)[0])
+        except KeyboardInterrupt as exc:
+            if interrupts is not None:
+                interrupts.append(exc)
+            return fallback
         except Exception as exc:  # noqa: BLE001
             if not errors:
                 errors.append(f"size({x:.6g}, {y:.6g}) raised {exc!r}")
@@ -457,8 +465,11 @@ def build_base_mesh(params: MeshParams, size: SizeFunction,
     errors: list[str] = []
     with _gmsh_model("ehlfoam-gap"):
         curves = _add_geometry(mesh_params)
-        gmsh.model.mesh.setSizeCallback(_size_callback(size, s_max, errors))
+        interrupts: list[BaseException] = []
+        gmsh.model.mesh.setSizeCallback(_size_callback(size, s_max, errors, interrupts))
         gmsh.model.mesh.generate(2)
+        if interrupts:
+            raise interrupts[0]
         if errors:
             raise ValueError(f"size(x, y) failed while meshing: {errors[0]}")
         points, quads, lines = _extract_mesh(curves)

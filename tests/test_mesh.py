@@ -379,6 +379,23 @@ def test_bad_size_raises_value_error() -> None:
     assert not gmsh.isInitialized()
 
 
+def test_interrupt_while_meshing_is_an_interrupt_not_a_broken_mesh() -> None:
+    """A Ctrl-C or a batch's stop signal that lands in gmsh's size callback comes out as
+    KeyboardInterrupt once gmsh returns (ctypes would swallow it and mesh with a size of 0:
+    a batch once recorded such a case as a failed build, "non-quadrilateral elements")."""
+    calls = {"n": 0}
+
+    def interrupted(x, y):
+        if np.ndim(x) == 0:
+            calls["n"] += 1
+            if calls["n"] == 50:
+                raise KeyboardInterrupt
+        return np.full(np.shape(x), 2e-5)
+    with pytest.raises(KeyboardInterrupt):
+        build_base_mesh(params(), interrupted)
+    assert calls["n"] >= 50 and not gmsh.isInitialized()
+
+
 def test_size_failing_inside_gmsh_leaves_no_gmsh_state() -> None:
     def scalar_hostile(x, y):
         if np.ndim(x) == 0:
