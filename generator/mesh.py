@@ -301,7 +301,7 @@ def _sample_size(params: MeshParams, size: SizeFunction) -> tuple[float, float, 
 
 
 def _size_callback(size: SizeFunction, fallback: float, errors: list[str],
-                   interrupts: list[BaseException] | None = None):
+                   interrupts: list[BaseException]):
     """gmsh size callback calling ``size`` on one point (np.float64 scalars).
 
     Problems are recorded in ``errors`` (raising through gmsh's C code is
@@ -314,8 +314,7 @@ def _size_callback(size: SizeFunction, fallback: float, errors: list[str],
         try:
             value = float(np.asarray(size(np.float64(x), np.float64(y)), dtype=float).reshape(-1)[0])
         except KeyboardInterrupt as exc:
-            if interrupts is not None:
-                interrupts.append(exc)
+            interrupts.append(exc)
             return fallback
         except Exception as exc:  # noqa: BLE001
             if not errors:

@@ -450,15 +450,15 @@ def _check_values(batch: BatchSpec, base: CaseSpec) -> None:
                                {dotted: getattr(r, key)}))
         if r.supply is not None:
             checks.append((f"{where} supply = {r.supply.label!r}", r.supply.overrides()))
-    for r in batch.ramp:
-        if r.start_from:
-            from .case_fields import time_folders
+    for r in (r for r in batch.ramp if r.start_from):
+        from .ramp import RampError, final_time   # what the step will start from
 
-            folder = Path(r.start_from)
-            if not folder.is_dir() or not time_folders(folder):
-                raise SpecError(f"invalid batch spec: ramp {r.name!r} start_from = "
-                                f"{r.start_from!r}: not a case folder with a written time "
-                                f"(give a case that has run)")
+        try:
+            final_time(r.start_from)
+        except (RampError, OSError):
+            raise SpecError(f"invalid batch spec: ramp {r.name!r} start_from = "
+                            f"{r.start_from!r}: not a case folder with a written time "
+                            f"(give a case that has run)") from None
     for where, overrides in checks:
         try:
             _case_spec(batch.base, "check", overrides)

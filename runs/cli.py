@@ -64,7 +64,7 @@ def cmd_case(args: argparse.Namespace) -> int:
 
         try:   # before anything is written
             final_time(args.start_from)
-        except (RampError, FileNotFoundError) as err:
+        except (RampError, OSError) as err:   # missing, or not a folder
             print(f"ehlfoam case: --start-from {args.start_from}: {err}", file=sys.stderr)
             return EXIT_BAD_INPUT
     try:
