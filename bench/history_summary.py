@@ -44,6 +44,9 @@ def summarise(case: str | Path) -> dict:
     span = (t_last[-1] - t_last[0]) / transit
     in_last, out_last = h["oil_in_m3_s"][-1], h["oil_out_m3_s"][-1]
     enclosed = (np.array(states)[last] == "I") & (h["bubble_length_over_a"][last] > 0)
+    before_open = t < opened if opened is not None else np.ones(t.size, bool)
+    bubbles = h["bubble_length_over_a"][before_open & (np.array(states) == "I")]
+    bubbles = bubbles[np.isfinite(bubbles)]
     return {
         "case": case.name,
         "cells": metrics.get("cells"),
@@ -59,6 +62,9 @@ def summarise(case: str | Path) -> dict:
         "first_open_s": opened,
         "first_open_transits": None if opened is None else opened / transit,
         "bubble_enclosed_last_transit": float(enclosed.mean()),
+        "largest_enclosed_bubble_before_open_over_a": (float(bubbles.max()) if bubbles.size
+                                                       else None),
+        "oil_mass_balance_error": metrics.get("oil_mass_balance_error"),
         "last_transit": window,
         "oil_volume_drift_per_transit": (float((volume[-1] - volume[0]) / volume[0] / span)
                                          if span > 0 else None),
@@ -77,9 +83,14 @@ def main(argv=None) -> int:
         w = r["last_transit"]
         opened = r["first_open_transits"]
         opened = "never" if opened is None else f"at {opened:.2f} transit"
+        largest = r["largest_enclosed_bubble_before_open_over_a"]
+        largest = "none" if largest is None else f"{largest:.2f} a"
+        balance = r["oil_mass_balance_error"]
+        balance = "-" if balance is None else f"{balance:.2%}"
         print(f"{r['case']}: {r['cells']} cells, {r['transits_written']:.2f} transits written, "
               f"{r['time_steps']} steps, {r['wall_s']:.0f} s wall, end {r['end_reason']}; "
-              f"states {r['states_per_write']}; first open {opened}")
+              f"states {r['states_per_write']}; first open {opened}; largest enclosed "
+              f"bubble before it {largest}; oil balance {balance}")
         print("   last transit: " + ", ".join(
             f"{k} {v['mean']:.4g} ({v['min']:.4g}-{v['max']:.4g}, {v['n']} writes)" if v
             else f"{k} not found" for k, v in w.items())
