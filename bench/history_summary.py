@@ -43,9 +43,10 @@ def summarise(case: str | Path) -> dict:
     volume, t_last = h["oil_volume_m3"][last], t[last]
     span = (t_last[-1] - t_last[0]) / transit
     in_last, out_last = h["oil_in_m3_s"][-1], h["oil_out_m3_s"][-1]
-    enclosed = (np.array(states)[last] == "I") & (h["bubble_length_over_a"][last] > 0)
-    before_open = t < opened if opened is not None else np.ones(t.size, bool)
-    bubbles = h["bubble_length_over_a"][before_open & (np.array(states) == "I")]
+    state = np.array(states)
+    enclosed = (state[last] == "I") & (h["bubble_length_over_a"][last] > 0)
+    before_open = np.cumsum(state == "II") == 0   # the writes before the wake first opened
+    bubbles = h["bubble_length_over_a"][before_open & (state == "I")]
     bubbles = bubbles[np.isfinite(bubbles)]
     return {
         "case": case.name,
