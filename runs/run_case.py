@@ -196,9 +196,10 @@ def _balance(amount: list[float], ins: list[float], outs: list[float], t: np.nda
 #: how the oil fluxes through the boundaries were read (``oil_flux_source`` in metrics.json)
 OIL_FLUX_EXACT = "alphaPhi0: the oil flux the solver transported"
 OIL_FLUX_APPROXIMATE = (
-    "phi x face alpha at the writes (the solver writes no alphaPhi0): approximate, but it "
-    "closed within 0.6 % on the 8 mm/s gas-release case and 0.14 % with a write every 4 steps, "
-    "once the upstream boundary stopped leaking oil (docs/cases.md)")
+    "phi x face alpha at the writes (the solver writes no alphaPhi0): approximate. It closes "
+    "within 1 % while no interface crosses an open boundary (state I); with an open wake it "
+    "misses part of the outflow whatever the write density (6 % of it on a 20 mm/s window "
+    "written every step; bench/balance_window.py, docs/cavitation.md)")
 
 
 def mass_balance(history: list[case_fields.Sample]) -> dict:
