@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -105,6 +105,9 @@ class Sample:
     gas_in: float | None = None     # kg/s of air entering through the open boundaries
     gas_out: float | None = None    # kg/s of air leaving
     oil_flux_exact: bool = True     # oil fluxes from the solver's alphaPhi0, not phi x alpha
+    #: m3/s of oil leaving through each open boundary but the supply (outlet, side, inlet):
+    #: oil leaving anywhere but the outlet means the flooded region or a film reached the edge
+    oil_out_by_boundary: dict[str, float] = field(default_factory=dict)
 
     def row(self) -> dict:
         keys = ("state", "inlet_meniscus_distance_over_a", "flooded_length_over_a",
@@ -113,8 +116,9 @@ class Sample:
         gas = ({} if self.gas_mass is None else
                {"gas_mass_kg": self.gas_mass, "gas_in_kg_s": self.gas_in,
                 "gas_out_kg_s": self.gas_out})
+        by_boundary = {f"oil_out_{name}_m3_s": q for name, q in self.oil_out_by_boundary.items()}
         return {"time_s": self.time, "oil_volume_m3": self.oil_volume,
-                "oil_in_m3_s": self.oil_in, "oil_out_m3_s": self.oil_out,
+                "oil_in_m3_s": self.oil_in, "oil_out_m3_s": self.oil_out, **by_boundary,
                 **{k: self.pattern.get(k) for k in keys}, **gas}
 
 
@@ -180,7 +184,8 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
                 flux = np.maximum(flux, 0.0)
         return flux
 
-    q_in, q_out = _in_out(oil_flux, structure, geom)
+    q_in, q_out, out_by_boundary = _in_out(oil_flux, structure, geom)
+    out_by_boundary.pop(SUPPLY_PATCH, None)
     mid = structure.mid_gap(alpha, geom.n_layers)
     r = metrics.raster(structure.base_x, structure.base_y, mid, pattern_geometry(geom))
     pattern = metrics.flow_pattern_from_raster(r)
@@ -191,20 +196,24 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     pattern["min_pressure_Pa"] = _min_pressure(p, geom)
     gas = _gas(folder, alpha, p, structure, geom) if geom.absolute_pressure else {}
     return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
-                  pattern=pattern, oil_flux_exact=exact, **gas)
+                  pattern=pattern, oil_flux_exact=exact, oil_out_by_boundary=out_by_boundary,
+                  **gas)
 
 
-def _in_out(face_flux, structure: Structure, geom: CaseGeometry) -> tuple[float, float]:
+def _in_out(face_flux, structure: Structure,
+            geom: CaseGeometry) -> tuple[float, float, dict[str, float]]:
     """What enters and what leaves (whole contact) through the open boundaries, for
-    ``face_flux(patch, size)``: the outward flux of each face of a patch."""
-    q_in = q_out = 0.0
+    ``face_flux(patch, size)``: the outward flux of each face of a patch; and what leaves
+    through each of them."""
+    q_in = 0.0
+    out_by_patch: dict[str, float] = {}
     for name in OPEN_PATCHES:
         if name not in structure.patches:
             continue
         flux = face_flux(name, structure.patches[name][1])
         q_in += float(-flux[flux < 0].sum())
-        q_out += float(flux[flux > 0].sum())
-    return geom.mirror * q_in, geom.mirror * q_out
+        out_by_patch[name] = geom.mirror * float(flux[flux > 0].sum())
+    return geom.mirror * q_in, sum(out_by_patch.values()), out_by_patch
 
 
 def _gas(folder: Path, alpha: np.ndarray, p: np.ndarray, structure: Structure,
@@ -227,7 +236,7 @@ def _gas(folder: Path, alpha: np.ndarray, p: np.ndarray, structure: Structure,
                / (AIR_GAS_CONSTANT * _uniform_or_list(t_b[name]["value"], size)))
         return rho * q
 
-    m_in, m_out = _in_out(gas_mass_flux, structure, geom)
+    m_in, m_out, _ = _in_out(gas_mass_flux, structure, geom)
     return {"gas_mass": mass, "gas_in": m_in, "gas_out": m_out}
 
 

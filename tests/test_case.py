@@ -254,6 +254,14 @@ def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     assert np.sum(FoamFieldFile(last / "phi").boundary_field["inlet"]["value"]) < 0
     rows = (case / "history.csv").read_text().splitlines()
     assert len(rows) >= 10 and rows[0].startswith("time_s,oil_volume_m3")
+    assert "oil_out_outlet_m3_s" in rows[0] and "oil_out_side_m3_s" in rows[0]
+    # where the oil leaves: split by boundary, adding up to the outflow, none upstream
+    by_boundary = m["oil_outflow_by_boundary_m3_s"]
+    assert set(by_boundary) == {"inlet", "outlet", "side"}
+    assert sum(by_boundary.values()) == pytest.approx(m["oil_outflow_m3_s"], rel=1e-12)
+    assert by_boundary["inlet"] == 0.0
+    off = m["oil_outflow_off_outlet_fraction"]
+    assert off is None or 0.0 <= off <= 1.0
     saved = json.loads((case / "metrics.json").read_text())
     assert saved["end_reason"] == "end_time" and saved["time_steps"] == m["time_steps"]
 
