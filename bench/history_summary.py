@@ -2,7 +2,9 @@
 
 For runs whose time folders are gone or were never brought back (a run made on another
 machine, a pruned case): the state at every write, when the wake first opened, and the mean,
-min and max over the last transit of the flow-pattern metrics and the oil volume's drift.
+min and max over the last transit of the flow-pattern metrics and the oil volume's drift, and
+the share of the outflow that left anywhere but through the outlet (runs whose history.csv
+has the per-boundary columns).
 
     python bench/history_summary.py CASE [CASE ...] [--save NAME.json] [--note TEXT]
 """
@@ -70,7 +72,18 @@ def summarise(case: str | Path) -> dict:
         "oil_volume_drift_per_transit": (float((volume[-1] - volume[0]) / volume[0] / span)
                                          if span > 0 else None),
         "outflow_over_inflow_last": float(out_last / in_last) if in_last > 0 else None,
+        "off_outlet_fraction_last_transit": _off_outlet_share(h, last),
     }
+
+
+def _off_outlet_share(h: dict[str, np.ndarray], last: np.ndarray) -> float | None:
+    """The share of the oil outflow over the writes ``last`` that left anywhere but through
+    the outlet, from the per-boundary columns of history.csv (None for runs made before it
+    had them: bench/outflow_split.py reads those from their fields)."""
+    if "oil_out_outlet_m3_s" not in h:
+        return None
+    total = float(np.nansum(h["oil_out_m3_s"][last]))
+    return 1.0 - float(np.nansum(h["oil_out_outlet_m3_s"][last])) / total if total > 0 else None
 
 
 def main(argv=None) -> int:
@@ -96,7 +109,9 @@ def main(argv=None) -> int:
             f"{k} {v['mean']:.4g} ({v['min']:.4g}-{v['max']:.4g}, {v['n']} writes)" if v
             else f"{k} not found" for k, v in w.items())
             + f"; oil volume drift {r['oil_volume_drift_per_transit']:+.2%}/transit, "
-              f"out/in {r['outflow_over_inflow_last']:.3f}")
+              f"out/in {r['outflow_over_inflow_last']:.3f}"
+            + ("" if r["off_outlet_fraction_last_transit"] is None else
+               f", off the outlet {r['off_outlet_fraction_last_transit']:.1%}"))
     if args.save:
         print(save(args.save, {"note": args.note, "rows": rows}))
     return 0
