@@ -20,6 +20,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import RESULTS, save  # noqa: E402
+from runs.case_fields import off_outlet_share  # noqa: E402
 from runs.report.case_data import read_history  # noqa: E402
 
 #: history.csv columns summarised over the last transit.
@@ -78,12 +79,13 @@ def summarise(case: str | Path) -> dict:
 
 def _off_outlet_share(h: dict[str, np.ndarray], last: np.ndarray) -> float | None:
     """The share of the oil outflow over the writes ``last`` that left anywhere but through
-    the outlet, from the per-boundary columns of history.csv (None for runs made before it
-    had them: bench/outflow_split.py reads those from their fields)."""
-    if "oil_out_outlet_m3_s" not in h:
-        return None
-    total = float(np.nansum(h["oil_out_m3_s"][last]))
-    return 1.0 - float(np.nansum(h["oil_out_outlet_m3_s"][last])) / total if total > 0 else None
+    the outlet, from the per-boundary columns ``oil_out_<boundary>_m3_s`` of history.csv
+    (None for runs made before it had them: bench/outflow_split.py reads those from their
+    fields)."""
+    prefix, suffix = "oil_out_", "_m3_s"
+    out = {key[len(prefix):-len(suffix)]: float(np.nansum(h[key][last])) for key in h
+           if key.startswith(prefix) and key.endswith(suffix) and key != "oil_out_m3_s"}
+    return off_outlet_share(out) if out else None
 
 
 def main(argv=None) -> int:

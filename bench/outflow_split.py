@@ -38,13 +38,12 @@ def outflow_split(case: str | Path, writes: int = 11) -> dict:
     names = sorted(samples[-1].oil_out_by_boundary)
     out = {name: float(np.mean([s.oil_out_by_boundary[name] for s in samples]))
            for name in names}
-    total = sum(out.values())
     return {"case": str(case), "writes": len(samples),
             "t_s": [samples[0].time, samples[-1].time],
             "exact_flux": all(s.oil_flux_exact for s in samples),
             "oil_in_m3_s": float(np.mean([s.oil_in for s in samples])),
             "oil_out_by_boundary_m3_s": out,
-            "off_outlet_fraction": 1.0 - out.get("outlet", 0.0) / total if total > 0 else None}
+            "off_outlet_fraction": case_fields.off_outlet_share(out)}
 
 
 def main() -> None:

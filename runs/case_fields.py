@@ -200,6 +200,15 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
                   **gas)
 
 
+def off_outlet_share(out_by_boundary: dict[str, float]) -> float | None:
+    """The share of the oil leaving through the boundaries open to the air (``{boundary:
+    outflow}``, any consistent unit) that did not leave through the outlet: near 0 when the
+    domain is wide enough; a large share means the flooded region or a wall film reached the
+    side or upstream edge. None when nothing left."""
+    total = sum(out_by_boundary.values())
+    return 1.0 - out_by_boundary.get("outlet", 0.0) / total if total > 0 else None
+
+
 def _in_out(face_flux, structure: Structure,
             geom: CaseGeometry) -> tuple[float, float, dict[str, float]]:
     """What enters and what leaves (whole contact) through the open boundaries, for

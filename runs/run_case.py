@@ -382,15 +382,6 @@ def _raise_interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
-def _off_outlet_fraction(last: case_fields.Sample | None) -> float | None:
-    """The share of the oil leaving at the last write that left anywhere but through the
-    outlet (the side or the upstream boundary): near 0 when the domain is wide enough; a
-    large share means the flooded region or a wall film reached the edge of the domain."""
-    if last is None or not last.oil_out_by_boundary or not last.oil_out > 0:
-        return None
-    return 1.0 - last.oil_out_by_boundary.get("outlet", 0.0) / last.oil_out
-
-
 def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, tail, wall, case) -> dict:
     last = history[-1] if history else None
     pattern = dict(last.pattern) if last else {}
@@ -407,7 +398,8 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "oil_inflow_m3_s": last.oil_in if last else None,
         "oil_outflow_m3_s": last.oil_out if last else None,
         "oil_outflow_by_boundary_m3_s": dict(last.oil_out_by_boundary) if last else None,
-        "oil_outflow_off_outlet_fraction": _off_outlet_fraction(last),
+        "oil_outflow_off_outlet_fraction": (case_fields.off_outlet_share(last.oil_out_by_boundary)
+                                            if last else None),
         **mass_balance(history),
         "contact_flow_m3_s": geom.contact_flow,
         "contact_flow_over_inflow": (geom.contact_flow / last.oil_in
