@@ -21,15 +21,13 @@ import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
-from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
-from common import solver_cpu_s  # noqa: E402
-from runs.cli import parse_value  # noqa: E402
+from common import solver_cpu_s, spec_option  # noqa: E402
 from runs.ramp import seed_from_previous  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
@@ -67,15 +65,6 @@ def row_of(case: Path, level: str, previous: str | None, build_s: float | None =
     return {"level": level, "started_from": previous, "build_s": build_s,
             "max_delta_t_s": load_geometry(case).max_delta_t, "solver_cpu_s": solver_cpu_s(case),
             **{k: m.get(k) for k in KEYS}}
-
-
-def spec_option(text: str) -> tuple[str, Any]:
-    """``KEY=VALUE`` of a spec option (dotted key, e.g. ``run.max_courant=1``), the value read
-    as ``ehlfoam case --set`` reads it (the spec validates it)."""
-    key, sep, value = text.partition("=")
-    if not sep or not key:
-        raise argparse.ArgumentTypeError(f"--set wants KEY=VALUE, got {text!r}")
-    return key, parse_value(value)
 
 
 def main(argv=None) -> int:

@@ -3,12 +3,14 @@ memory is its own and numba's compile time is paid before the clock starts)."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import multiprocessing as mp
 import resource
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 RESULTS = Path(__file__).resolve().parent / "results"
 
@@ -70,3 +72,14 @@ def solver_cpu_s(case: Path) -> float | None:
     text = logs[0].read_text(errors="replace")
     times = re.findall(r"^ExecutionTime = ([0-9.eE+-]+) s", text, re.M)
     return float(times[-1]) if times else None
+
+
+def spec_option(text: str) -> tuple[str, Any]:
+    """``KEY=VALUE`` of a spec option (dotted key, e.g. ``run.max_courant=1``), the value read
+    as ``ehlfoam case --set`` reads it (the spec validates it); an argparse ``type``."""
+    from runs.cli import parse_value
+
+    key, sep, value = text.partition("=")
+    if not sep or not key:
+        raise argparse.ArgumentTypeError(f"--set wants KEY=VALUE, got {text!r}")
+    return key, parse_value(value)

@@ -8,7 +8,8 @@ nominal rolling speed. Writes ``bench/results/static_meniscus.json``.
 
     python bench/static_meniscus.py [--speed 0.008] [--time 0.02] [--levels coarse medium]
         [--compression 0 1] [--safety 1 0.25] [--air-viscosity 1.8e-5]
-        [--nhat default pointCellsLeastSquares] [--tag NAME] [--reanalyse]
+        [--nhat default pointCellsLeastSquares] [--set KEY=VALUE ...] [--tag NAME]
+        [--reanalyse]
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from foamlib import FoamFieldFile, FoamFile  # noqa: E402
 
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
+from common import spec_option  # noqa: E402
 from runs import case_fields  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
@@ -70,6 +72,9 @@ def main(argv=None) -> int:
     ap.add_argument("--nhat", nargs="+", default=["default"],
                     help="gradient schemes for the interface normal (fvSchemes gradSchemes "
                          "nHat; 'default' keeps the template's Gauss linear)")
+    ap.add_argument("--set", action="append", default=[], type=spec_option, metavar="KEY=VALUE",
+                    help="any other spec option for every case (e.g. mesh.polar_radius=6.8); "
+                         "the cases go to folders with the options in their names")
     ap.add_argument("--tag", default="", help="results go to static_meniscus[_TAG].json")
     ap.add_argument("--reanalyse", action="store_true",
                     help="measure the cases already run in --work again instead of re-running")
@@ -84,8 +89,9 @@ def main(argv=None) -> int:
                        "initial_puddle": 3.0},
             "physics": {"interface_compression": c_alpha, "air_viscosity": mu_air},
             "run": {"end_time": args.time, "capillary_safety": safety,
-                    "writes_per_transit": 200}})
-        name = f"{level}_c{c_alpha:g}_s{safety:g}_air{mu_air:g}_t{args.time:g}"
+                    "writes_per_transit": 200}}, **dict(args.set))
+        name = f"{level}_c{c_alpha:g}_s{safety:g}_air{mu_air:g}_t{args.time:g}" + "".join(
+            f"_{key.split('.')[-1]}{value}" for key, value in args.set)
         case = Path(args.work) / (name if nhat == "default" else f"{name}_{nhat.replace(' ', '')}")
         if args.reanalyse and (case / "metrics.json").exists():
             geom = load_geometry(case)
@@ -99,6 +105,7 @@ def main(argv=None) -> int:
             m = run_case(case)
         s = spurious(case)
         row = {"level": level, "cAlpha": c_alpha, "capillary_safety": safety, "nHat": nhat,
+               "options": dict(args.set),
                "air_viscosity": mu_air,
                "air_viscosity_in_solver": mu_air * spec.run.air_viscosity_factor,
                "max_delta_t_s": geom.max_delta_t, "cells": geom.cells,

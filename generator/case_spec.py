@@ -176,6 +176,11 @@ class Mesh(BaseModel):
         size_rim, size_far: in-plane cell size at the island rim / far away, units of a.
         wall_grading: mid-gap cell height over wall cell height (1: uniform layers); finer
             cells at the walls carry the supply layers and the films left behind.
+        polar_radius: outer radius, units of a, of a structured polar ring of cells around
+            the island (log-polar, near-square cells, the size growing with the radius as
+            everywhere); None: free quads everywhere. Below 0.95 x the nearest boundary.
+            A circular meniscus meets every ring cell the same way (docs/cases.md, "A polar
+            ring around the contact").
     """
 
     model_config = _STRICT
@@ -184,6 +189,7 @@ class Mesh(BaseModel):
     size_rim: float | None = Field(None, gt=0.0, le=10.0)
     size_far: float | None = Field(None, gt=0.0, le=50.0)
     wall_grading: float | None = Field(None, ge=1.0, le=100.0)
+    polar_radius: float | None = Field(None, gt=1.0, le=200.0)
 
     def level(self) -> dict[str, float]:
         """The level's sizes with the overrides applied."""
@@ -275,6 +281,18 @@ class CaseSpec(BaseModel):
     mesh: Mesh = Mesh()
     run: Run = Run()
     walls_moving: bool = True
+
+    @model_validator(mode="after")
+    def _polar_ring_inside(self) -> "CaseSpec":
+        rp, d = self.mesh.polar_radius, self.domain
+        if rp is not None:
+            top = 0.95 * min(d.upstream, d.downstream, d.side)
+            if not d.island_radius < rp <= top:
+                raise ValueError(f"mesh.polar_radius = {rp:g} a must lie in "
+                                 f"({d.island_radius:g}, {top:g}] a: beyond the island "
+                                 f"(domain.island_radius) and within 0.95 x the nearest "
+                                 f"boundary")
+        return self
 
     # ---- derived quantities: the one place they are computed ---------------------------
     @property

@@ -397,7 +397,9 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
     d = spec.domain
     params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
                         island_radius=d.island_radius * a, n_layers=level["n_layers"],
-                        symmetric=d.symmetry == "half")
+                        symmetric=d.symmetry == "half",
+                        polar_radius=None if spec.mesh.polar_radius is None
+                        else spec.mesh.polar_radius * a)
     mesh = extrude(build_base_mesh(params, size_function(spec)), gap, level["n_layers"],
                    level["wall_grading"])
     mesh, supply = with_supply_patch(spec, mesh)

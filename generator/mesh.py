@@ -106,7 +106,10 @@ class MeshParams:
     ``island_radius`` at the origin must lie strictly inside it:
     ``x_min < -island_radius``, ``island_radius < x_max``,
     ``island_radius < y_max``. ``n_layers`` is the number of cells across
-    the gap.
+    the gap. ``polar_radius`` (None: no ring) is the outer radius of a
+    structured polar ring around the island (see :func:`build_base_mesh`);
+    ``island_radius < polar_radius`` and the ring must lie strictly inside
+    the rectangle.
     """
 
     x_min: float
@@ -115,6 +118,7 @@ class MeshParams:
     island_radius: float
     n_layers: int
     symmetric: bool = True
+    polar_radius: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("x_min", "x_max", "y_max", "island_radius"):
@@ -135,6 +139,13 @@ class MeshParams:
                 f"y_max must be > island_radius = {r:.6g} m (the island must lie inside "
                 f"the rectangle), got y_max = {self.y_max!r}")
         _check_n_layers(self.n_layers)
+        if self.polar_radius is not None:
+            rp = _require_finite("polar_radius", self.polar_radius)
+            nearest = min(-float(self.x_min), float(self.x_max), float(self.y_max))
+            if not r < rp < nearest:
+                raise ValueError(
+                    f"polar_radius must lie between island_radius = {r:.6g} m and the nearest "
+                    f"boundary ({nearest:.6g} m from the centre), got {self.polar_radius!r}")
         if not isinstance(self.symmetric, (bool, np.bool_)):
             raise ValueError(f"symmetric must be True or False, got {self.symmetric!r}")
 
@@ -237,10 +248,84 @@ def _gmsh_model(name: str) -> Iterator[None]:
                     gmsh.option.setNumber(key, value)
 
 
-def _add_geometry(params: MeshParams) -> dict[str, list[int]]:
+def _polar_divisions(params: MeshParams, size: SizeFunction) -> tuple[int, int]:
+    """Cells of the polar ring: (per quarter turn, across the ring).
+
+    The ring's cells are near-squares in log-polar spacing: the angular step
+    is the size at the island rim over the island radius, and the radii grow
+    by the same factor, so the cell size grows in proportion to the radius
+    from size(island rim) (what :func:`generator.case_writer.size_function`
+    asks for everywhere). The quarter turn has an even number of cells.
+    """
+    r, rp = float(params.island_radius), float(params.polar_radius)
+    rim = float(np.asarray(size(np.float64(0.0), np.float64(r)), dtype=float).reshape(-1)[0])
+    quarter = max(2, 2 * round(0.25 * math.pi * r / rim))   # even: gmsh's full-quad
+    # recombination needs an even number of segments on every curve of a free surface
+    radial = max(1, round(math.log(rp / r) / (0.5 * math.pi / quarter)))
+    return quarter, radial
+
+
+def _add_polar_half(params: MeshParams, size: SizeFunction) -> dict[str, list[int]]:
+    """The half domain with a structured polar ring around the island (transfinite,
+    log-polar spacing) and the rest meshed freely; return patch -> curve tags."""
+    import gmsh
+
+    geo = gmsh.model.geo
+    r, rp, x0, x1, ym = (float(params.island_radius), float(params.polar_radius),
+                         float(params.x_min), float(params.x_max), float(params.y_max))
+    quarter, radial = _polar_divisions(params, size)
+    centre = geo.addPoint(0.0, 0.0, 0.0)
+    p = {name: geo.addPoint(x, y, 0.0) for name, (x, y) in {
+        "x0": (x0, 0.0), "-R": (-rp, 0.0), "-r": (-r, 0.0), "r_top": (0.0, r),
+        "r": (r, 0.0), "R": (rp, 0.0), "R_top": (0.0, rp), "x1": (x1, 0.0),
+        "x1_top": (x1, ym), "x0_top": (x0, ym)}.items()}
+    sym = [geo.addLine(p["x0"], p["-R"]), geo.addLine(p["-r"], p["-R"]),
+           geo.addLine(p["r"], p["R"]), geo.addLine(p["R"], p["x1"])]
+    island = [geo.addCircleArc(p["-r"], centre, p["r_top"]),
+              geo.addCircleArc(p["r_top"], centre, p["r"])]
+    ring = [geo.addCircleArc(p["-R"], centre, p["R_top"]),
+            geo.addCircleArc(p["R_top"], centre, p["R"])]
+    outlet = geo.addLine(p["x1"], p["x1_top"])
+    side = geo.addLine(p["x1_top"], p["x0_top"])
+    inlet = geo.addLine(p["x0_top"], p["x0"])
+    inner = geo.addPlaneSurface([geo.addCurveLoop(
+        [island[0], island[1], sym[2], -ring[1], -ring[0], -sym[1]])])
+    geo.addPlaneSurface([geo.addCurveLoop(
+        [sym[0], ring[0], ring[1], sym[3], outlet, side, inlet])])
+    geo.synchronize()
+    mesh = gmsh.model.mesh
+    for arc in island + ring:
+        mesh.setTransfiniteCurve(arc, quarter + 1)
+    growth = (rp / r) ** (1.0 / radial)
+    for spoke in sym[1:3]:                          # both run outward from the island
+        mesh.setTransfiniteCurve(spoke, radial + 1, "Progression", growth)
+    mesh.setTransfiniteSurface(inner, cornerTags=[p["-r"], p["r"], p["R"], p["-R"]])
+    mesh.setRecombine(2, inner)
+    return {"island": island, "inlet": [inlet], "outlet": [outlet], "side": [side],
+            "symmetry": sym}
+
+
+def _snap_polar(points: np.ndarray, params: MeshParams, size: SizeFunction) -> None:
+    """Put the ring's nodes exactly on their log-polar grid (in place): gmsh's transfinite
+    interpolation leaves them up to ~1e-4 of the radius off their circles."""
+    r, rp = float(params.island_radius), float(params.polar_radius)
+    quarter, radial = _polar_divisions(params, size)
+    rho = np.hypot(points[:, 0], points[:, 1])
+    ring = (rho >= r * (1.0 - 1e-6)) & (rho <= rp * (1.0 + 1e-6))   # not gmsh's centre point
+    step_r = math.log(rp / r) / radial
+    step_t = 0.5 * math.pi / quarter
+    k = np.round(np.log(rho[ring] / r) / step_r)
+    j = np.round(np.arctan2(points[ring, 1], points[ring, 0]) / step_t)
+    points[ring] = (r * np.exp(k * step_r))[:, None] * np.stack(
+        [np.cos(j * step_t), np.sin(j * step_t)], axis=1)
+
+
+def _add_geometry(params: MeshParams, size: SizeFunction) -> dict[str, list[int]]:
     """Build the domain in gmsh's built-in kernel; return patch -> curve tags."""
     import gmsh
 
+    if params.polar_radius is not None:
+        return _add_polar_half(params, size)
     geo = gmsh.model.geo
     r, x0, x1, ym = (float(params.island_radius), float(params.x_min),
                      float(params.x_max), float(params.y_max))
@@ -447,6 +532,14 @@ def build_base_mesh(params: MeshParams, size: SizeFunction,
     (size(x, -y) == size(x, y) on a sample grid) the half domain is meshed
     and mirrored, so the mesh itself is symmetric about y = 0; otherwise
     gmsh meshes the whole rectangle.
+
+    Polar ring (``params.polar_radius`` set): the annulus between the island
+    and ``polar_radius`` is a structured log-polar grid (radial spokes,
+    circular rings, near-square cells of angular step size(rim) / island
+    radius), the rest is meshed freely. A meniscus that follows a circle
+    about the contact then meets every cell of the ring the same way, so
+    the error of its discrete curvature does not change from cell to cell
+    along it (docs/cases.md, "A polar ring around the contact").
     """
     import gmsh
 
@@ -460,10 +553,17 @@ def build_base_mesh(params: MeshParams, size: SizeFunction,
             f"size(x, y) asks for about {estimate:.3g} quads (sizes {s_min:.3g}..{s_max:.3g} m), "
             f"more than max_quads = {max_quads}; is size in metres?")
     mirror = not params.symmetric and even
+    if params.polar_radius is not None and not params.symmetric and not mirror:
+        raise ValueError("a polar ring in the full domain needs a size even in y "
+                         "(size(x, -y) == size(x, y)): the half ring is meshed and mirrored")
     mesh_params = replace(params, symmetric=True) if mirror else params
     errors: list[str] = []
     with _gmsh_model("ehlfoam-gap"):
-        curves = _add_geometry(mesh_params)
+        if params.polar_radius is not None:
+            # blossom recombination leaves quads 40-58 degrees non-orthogonal along the
+            # ring's fixed nodes; simple full-quad keeps them below ~30 (docs/cases.md)
+            gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 2)
+        curves = _add_geometry(mesh_params, size)
         interrupts: list[BaseException] = []
         gmsh.model.mesh.setSizeCallback(_size_callback(size, s_max, errors, interrupts))
         gmsh.model.mesh.generate(2)
@@ -472,6 +572,8 @@ def build_base_mesh(params: MeshParams, size: SizeFunction,
         if errors:
             raise ValueError(f"size(x, y) failed while meshing: {errors[0]}")
         points, quads, lines = _extract_mesh(curves)
+    if params.polar_radius is not None:
+        _snap_polar(points, mesh_params, size)
     base = _finish_base_mesh(points, quads, lines, mesh_params)
     return _mirror(base) if mirror else base
 

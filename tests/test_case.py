@@ -48,6 +48,7 @@ def _copy(case: Path, tmp_path: Path) -> Path:
     ("[supply]\nlayer = 1e-6\n", "supply.layer: unknown parameter", "disc_layer"),
     ("[mesh]\nresolution = \"ultra\"\n", "mesh.resolution = 'ultra'", "'coarse', 'medium' or 'fine'"),
     ("[domain]\nisland_radius = 9.0\n", "island_radius = 9 a", "nearest boundary"),
+    ("[mesh]\npolar_radius = 7.9\n", "mesh.polar_radius = 7.9 a", "(1.5, 7.6] a"),
     ("[contact]\ntemperature = 99.0\n", "temperature = 99 C", "valid range 25 to 60 C"),
     ("[run]\nsteady_tolerance = 2.0\n", "run.steady_tolerance = 2.0", "steady_tolerance < 1"),
     ("scene = \"gas-release\"\n[physics]\ngas_release_rate = 0.0\n",
@@ -119,9 +120,10 @@ def test_time_step_options_reach_the_dictionaries(tmp_path):
         capillary_time_step(default, dx) * 1.5 / 3.0, rel=1e-12)
 
 
-@pytest.mark.parametrize("level", ["coarse", "medium"])
-def test_meshed_gap_matches_the_gap_export(level):
-    """At the resolution levels the meshed gap is the precalc's gap within 1 %."""
+@pytest.mark.parametrize("level, ring", [("coarse", False), ("medium", False), ("medium", True)])
+def test_meshed_gap_matches_the_gap_export(level, ring):
+    """At the resolution levels the meshed gap is the precalc's gap within 1 %, with or
+    without the polar ring."""
     from generator.case_writer import size_function
     from generator.gap_source import load_gap
     from generator.mesh import MeshParams, build_base_mesh, extrude, gap_mismatch
@@ -130,7 +132,9 @@ def test_meshed_gap_matches_the_gap_export(level):
     gap, _ = load_gap(spec.contact)
     a, d = spec.a, spec.domain
     params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
-                        island_radius=d.island_radius * a, n_layers=2)
+                        island_radius=d.island_radius * a, n_layers=2,
+                        polar_radius=0.8 * min(d.upstream, d.downstream, d.side) * a
+                        if ring else None)
     mesh = extrude(build_base_mesh(params, size_function(spec)), gap, 2)
     assert gap_mismatch(mesh, gap) < 0.01
 

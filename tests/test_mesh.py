@@ -352,6 +352,45 @@ def test_full_domain_with_uneven_size_is_meshed_whole(runtime: FoamRuntime,
     check_mesh(runtime, write_case(full, tmp_path / "uneven"))
 
 
+def test_polar_ring_is_log_polar_and_the_rest_is_free(runtime: FoamRuntime,
+                                                       tmp_path: Path) -> None:
+    r_polar = 4 * A_HERTZ
+    p = params(polar_radius=r_polar)
+    base = build_base_mesh(p, sizer(2.0))
+    assert base.quad_areas().min() > 0
+    assert base.quad_areas().sum() == pytest.approx(p.area, rel=2e-3)
+    # the ring: nodes on a few exact circles and spokes, radii in geometric progression
+    rho = np.hypot(*base.points.T)
+    ring = rho <= r_polar * (1 + 1e-9)
+    radii = np.unique(np.round(rho[ring] / A_HERTZ, 9))
+    assert radii[0] == pytest.approx(R_ISLAND / A_HERTZ) and radii[-1] == pytest.approx(4.0)
+    assert len(radii) < 0.1 * ring.sum()                      # a handful of circles
+    assert np.allclose(radii[1:] / radii[:-1], radii[1] / radii[0], rtol=1e-9)
+    angles = np.unique(np.round(np.arctan2(*base.points[ring].T[::-1]), 9))
+    step = math.pi / (len(angles) - 1)
+    assert np.allclose(np.diff(angles), step, rtol=1e-6)
+    # near-square cells of angular step size(rim) / island radius: as many as the free mesh
+    assert step == pytest.approx(0.04 * 2.0 * A_HERTZ / R_ISLAND, rel=0.1)
+    assert radii[1] / radii[0] == pytest.approx(math.exp(step), rel=0.01)
+    assert base.n_quads == pytest.approx(build_base_mesh(params(), sizer(2.0)).n_quads, rel=0.1)
+    # every ring quad is a polar cell: two nodes on each of two neighbouring circles
+    centres = base.points[base.quads].mean(axis=1)
+    in_ring = np.hypot(*centres.T) < r_polar
+    k = np.round(np.log(rho[base.quads[in_ring]] / R_ISLAND) / math.log(radii[1] / radii[0]))
+    assert np.all(np.sort(k, axis=1)[:, [0, 1, 2, 3]] - np.sort(k, axis=1)[:, [0, 0, 2, 2]]
+                  == 0)
+    assert np.all(np.sort(k, axis=1)[:, 2] - np.sort(k, axis=1)[:, 0] == 1)
+    mesh = extrude(base, hertz_gap, N_LAYERS)
+    assert mesh.cell_volumes.sum() == pytest.approx(gap_integral(p), rel=0.01)
+    stats = check_mesh(runtime, write_case(mesh, tmp_path / "polar"))
+    assert stats["max_non_orthogonality"] < 30
+    full = build_base_mesh(params(symmetric=False, polar_radius=r_polar), sizer(2.0))
+    assert full.n_quads == 2 * base.n_quads                  # the half ring mirrored
+    with pytest.raises(ValueError, match="even in y"):
+        build_base_mesh(params(symmetric=False, polar_radius=r_polar),
+                        lambda x, y: sizer(2.0)(x, y) * np.where(y < 0, 1.5, 1.0))
+
+
 # ------------------------------------------------------------------ bad input
 @pytest.mark.parametrize("change, word", [
     (dict(island_radius=-1e-4), "island_radius"),
@@ -363,6 +402,8 @@ def test_full_domain_with_uneven_size_is_meshed_whole(runtime: FoamRuntime,
     (dict(n_layers=0), "n_layers"),
     (dict(n_layers=2.5), "n_layers"),
     (dict(symmetric="yes"), "symmetric"),
+    (dict(polar_radius=R_ISLAND), "polar_radius"),
+    (dict(polar_radius=6 * A_HERTZ), "polar_radius"),
 ])
 def test_bad_params_raise_value_error_naming_them(change: dict, word: str) -> None:
     with pytest.raises(ValueError, match=word):
