@@ -320,7 +320,7 @@ def _far_extent(region: np.ndarray, alpha: np.ndarray, gas: np.ndarray,
     step = np.diff(coords)
     a0, a1 = alpha[:, :-1], alpha[:, 1:]
     ends = region[:, :-1] & gas[:, 1:]
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # only ends are kept
         frac = np.where(ends, (a0 - threshold) / (a0 - a1), 0.0)
     reach[:, :-1] += np.clip(np.nan_to_num(frac), 0.0, 1.0) * step
     return float(reach[region].max())
