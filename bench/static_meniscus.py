@@ -62,10 +62,10 @@ def spurious(case: Path) -> dict:
     (the currents come in bursts)."""
     times = case_fields.time_folders(case)
     st = case_fields.Structure.load(case)
-    out = _speeds(times[-1][1], st)
     end = float(times[-1][0])
     late = [_speeds(folder, st) for t, folder in times if float(t) >= 0.5 * end]
-    out.update({f"{key}_late": max(row[key] for row in late) for key in late[0]})
+    out = dict(late[-1])                                      # the last write
+    out.update({f"{key}_late": max(row[key] for row in late) for key in late[-1]})
     return out
 
 

@@ -265,15 +265,16 @@ def _polar_divisions(params: MeshParams, size: SizeFunction) -> tuple[int, int]:
     return quarter, radial
 
 
-def _add_polar_half(params: MeshParams, size: SizeFunction) -> dict[str, list[int]]:
+def _add_polar_half(params: MeshParams, divisions: tuple[int, int]) -> dict[str, list[int]]:
     """The half domain with a structured polar ring around the island (transfinite,
-    log-polar spacing) and the rest meshed freely; return patch -> curve tags."""
+    log-polar spacing, ``divisions`` from :func:`_polar_divisions`) and the rest meshed
+    freely; return patch -> curve tags."""
     import gmsh
 
     geo = gmsh.model.geo
     r, rp, x0, x1, ym = (float(params.island_radius), float(params.polar_radius),
                          float(params.x_min), float(params.x_max), float(params.y_max))
-    quarter, radial = _polar_divisions(params, size)
+    quarter, radial = divisions
     centre = geo.addPoint(0.0, 0.0, 0.0)
     p = {name: geo.addPoint(x, y, 0.0) for name, (x, y) in {
         "x0": (x0, 0.0), "-R": (-rp, 0.0), "-r": (-r, 0.0), "r_top": (0.0, r),
@@ -305,11 +306,11 @@ def _add_polar_half(params: MeshParams, size: SizeFunction) -> dict[str, list[in
             "symmetry": sym}
 
 
-def _snap_polar(points: np.ndarray, params: MeshParams, size: SizeFunction) -> None:
+def _snap_polar(points: np.ndarray, params: MeshParams, divisions: tuple[int, int]) -> None:
     """Put the ring's nodes exactly on their log-polar grid (in place): gmsh's transfinite
     interpolation leaves them up to ~1e-4 of the radius off their circles."""
     r, rp = float(params.island_radius), float(params.polar_radius)
-    quarter, radial = _polar_divisions(params, size)
+    quarter, radial = divisions
     rho = np.hypot(points[:, 0], points[:, 1])
     ring = (rho >= r * (1.0 - 1e-6)) & (rho <= rp * (1.0 + 1e-6))   # not gmsh's centre point
     step_r = math.log(rp / r) / radial
@@ -320,12 +321,14 @@ def _snap_polar(points: np.ndarray, params: MeshParams, size: SizeFunction) -> N
         [np.cos(j * step_t), np.sin(j * step_t)], axis=1)
 
 
-def _add_geometry(params: MeshParams, size: SizeFunction) -> dict[str, list[int]]:
-    """Build the domain in gmsh's built-in kernel; return patch -> curve tags."""
+def _add_geometry(params: MeshParams,
+                  divisions: tuple[int, int] | None) -> dict[str, list[int]]:
+    """Build the domain in gmsh's built-in kernel (with the polar ring of ``divisions``
+    when the params ask for one); return patch -> curve tags."""
     import gmsh
 
     if params.polar_radius is not None:
-        return _add_polar_half(params, size)
+        return _add_polar_half(params, divisions)
     geo = gmsh.model.geo
     r, x0, x1, ym = (float(params.island_radius), float(params.x_min),
                      float(params.x_max), float(params.y_max))
@@ -557,13 +560,14 @@ def build_base_mesh(params: MeshParams, size: SizeFunction,
         raise ValueError("a polar ring in the full domain needs a size even in y "
                          "(size(x, -y) == size(x, y)): the half ring is meshed and mirrored")
     mesh_params = replace(params, symmetric=True) if mirror else params
+    divisions = _polar_divisions(params, size) if params.polar_radius is not None else None
     errors: list[str] = []
     with _gmsh_model("ehlfoam-gap"):
         if params.polar_radius is not None:
             # blossom recombination leaves quads 40-58 degrees non-orthogonal along the
             # ring's fixed nodes; simple full-quad keeps them below ~30 (docs/cases.md)
             gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 2)
-        curves = _add_geometry(mesh_params, size)
+        curves = _add_geometry(mesh_params, divisions)
         interrupts: list[BaseException] = []
         gmsh.model.mesh.setSizeCallback(_size_callback(size, s_max, errors, interrupts))
         gmsh.model.mesh.generate(2)
@@ -573,7 +577,7 @@ def build_base_mesh(params: MeshParams, size: SizeFunction,
             raise ValueError(f"size(x, y) failed while meshing: {errors[0]}")
         points, quads, lines = _extract_mesh(curves)
     if params.polar_radius is not None:
-        _snap_polar(points, mesh_params, size)
+        _snap_polar(points, mesh_params, divisions)
     base = _finish_base_mesh(points, quads, lines, mesh_params)
     return _mirror(base) if mirror else base
 
