@@ -2,11 +2,15 @@
 report of issue 5): oil dark, air light, the island (unmeshed contact) black, the Hertzian
 circle red, the metrics in the titles.
 
-    python bench/plot_midgap.py OUT.png CASE [CASE ...]
+    python bench/plot_midgap.py OUT.png CASE[@TRANSITS] [CASE[@TRANSITS] ...]
+
+CASE@2.6 shows the write nearest 2.6 transits (the state and bubble in its title then come from
+the case's history.csv at that write); a bare CASE shows the last write and its metrics.json.
 """
 
 from __future__ import annotations
 
+import csv
 import json
 import sys
 from pathlib import Path
@@ -30,13 +34,15 @@ def main(argv=None) -> int:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    out, cases = Path(argv[0]), [Path(c) for c in argv[1:]]
-    fig, axs = plt.subplots(len(cases), 1, figsize=(7, 3.6 * len(cases)), squeeze=False,
+    out, picks = Path(argv[0]), [_pick(arg) for arg in argv[1:]]
+    fig, axs = plt.subplots(len(picks), 1, figsize=(7, 3.6 * len(picks)), squeeze=False,
                             gridspec_kw={"hspace": 0.45})
-    for ax, case in zip(axs[:, 0], cases):
+    for ax, (case, at) in zip(axs[:, 0], picks):
         g = load_geometry(case)
         st = case_fields.Structure.load(case)
-        t, folder = case_fields.time_folders(case)[-1]
+        times = case_fields.time_folders(case)
+        t, folder = (times[-1] if at is None
+                     else min(times, key=lambda tf: abs(tf[0] - at * g.transit_time)))
         mid = np.clip(case_fields.mid_gap_alpha(folder, st, g), 0.0, 0.9999)  # inside the top level
         x, y = st.base_x / g.a, st.base_y / g.a
         if g.symmetric:
@@ -44,7 +50,7 @@ def main(argv=None) -> int:
         tc = ax.tricontourf(x, y, mid, levels=np.linspace(0, 1, 11), cmap="Blues")
         ax.add_patch(plt.Circle((0, 0), g.island_radius / g.a, color="k"))
         ax.add_patch(plt.Circle((0, 0), 1.0, color="r", fill=False, lw=1))
-        m = json.loads((case / "metrics.json").read_text()) if (case / "metrics.json").exists() else {}
+        m = _metrics_at(case, None if at is None else t)
         spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
         sup = spec["supply"]
         supply = ("flooded" if sup["mode"] == "flooded"
@@ -59,17 +65,51 @@ def main(argv=None) -> int:
                      f"t = {t * 1e3:.0f} ms: "
                      f"state {m.get('state', '?')}, inlet meniscus "
                      f"{fmt(m.get('inlet_meniscus_distance_over_a'))} a "
-                     f"({m.get('inlet_meniscus_shape') or '-'})", fontsize=8)
+                     f"({m.get('inlet_meniscus_shape') or '-'})"
+                     + (f", bubble {fmt(m.get('bubble_length_over_a'))} a"
+                        if m.get("bubble_length_over_a") else ""), fontsize=8)
         ax.set_aspect("equal")
         ax.set_xlabel("x / a (rolling ->)")
         ax.set_ylabel("y / a")
     fig.colorbar(tc, ax=axs.ravel().tolist(), label="oil fraction at mid-gap",
-                 orientation="horizontal", fraction=0.02 if len(cases) > 1 else 0.05,
-                 pad=0.04 if len(cases) > 1 else 0.2)
+                 orientation="horizontal", fraction=0.02 if len(picks) > 1 else 0.05,
+                 pad=0.04 if len(picks) > 1 else 0.2)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110, bbox_inches="tight")
     print(f"wrote {out}")
     return 0
+
+
+def _pick(arg: str) -> tuple[Path, float | None]:
+    """"CASE" or "CASE@TRANSITS" -> (case folder, transits or None for the last write)."""
+    case, sep, at = arg.rpartition("@")
+    if not sep:
+        return Path(arg), None
+    try:
+        return Path(case), float(at)
+    except ValueError:
+        raise SystemExit(f"plot_midgap: {arg!r}: the part after @ must be a number of transits")
+
+
+def _metrics_at(case: Path, t: float | None) -> dict:
+    """metrics.json (t None), or the history.csv row nearest time t [s], numbers parsed."""
+    if t is None:
+        f = case / "metrics.json"
+        return json.loads(f.read_text()) if f.exists() else {}
+    f = case / "history.csv"
+    if not f.exists():
+        return {}
+    rows = list(csv.DictReader(f.open()))
+    if not rows:
+        return {}
+    row = min(rows, key=lambda r: abs(float(r["time_s"]) - t))
+    out: dict = {}
+    for k, v in row.items():
+        try:
+            out[k] = float(v)
+        except (TypeError, ValueError):
+            out[k] = v or None
+    return out
 
 
 if __name__ == "__main__":
