@@ -115,6 +115,11 @@ class Physics(BaseModel):
         gas_release_rate: [1/(Pa s)] of the gas-release scene: oil below the cavitation
             pressure releases gas at k (p_cav - p) volumes of gas per volume of oil per
             second, which is never taken back (Kunz's model without its condensation term).
+        air_solubility: Bunsen coefficient of air in the oil: volumes of air (at ambient
+            pressure) a volume of oil saturated at ambient pressure holds dissolved; ~0.09
+            for mineral oils. The gas-release scene has no budget of dissolved air; the run
+            reports its release against what all the oil could give up
+            (``gas_release_over_dissolved_air`` in metrics.json).
         oil_bulk_modulus: [Pa] of the oil in the cavitating scene; None (the default) keeps
             the oil incompressible. A value (a mineral oil's isothermal one at ambient
             pressure is ~1.5 GPa) makes it a perfect fluid, which compressibleInterFoam does
@@ -135,6 +140,7 @@ class Physics(BaseModel):
     cavitation_pressure: float = Field(1e3, gt=0.0, le=1e5)
     oil_bulk_modulus: float | None = Field(None, gt=1e6, le=1e11)
     gas_release_rate: float = Field(1e-3, gt=0.0, le=1e3)
+    air_solubility: float = Field(0.09, ge=0.0, le=1.0)
 
 
 class Domain(BaseModel):

@@ -73,6 +73,11 @@ class CaseGeometry:
     oil_density: float
     solver: str = "interFoam"
     ambient_pressure: float = 1.013e5
+    #: the gas-release scene's k [1/(Pa s)] (0: the scene releases nothing), its release
+    #: pressure as the solver's gauge pSat [Pa] and the oil's Bunsen coefficient for air
+    gas_release_rate: float = 0.0
+    release_pressure_gauge: float = 0.0
+    air_solubility: float = 0.09
 
     @property
     def mirror(self) -> float:
@@ -331,6 +336,11 @@ def _edit_transport(spec: CaseSpec, case: Path) -> None:
                 f[key] = value
 
 
+def release_pressure_gauge(spec: CaseSpec) -> float:
+    """The gas-release scene's release pressure as its solver sees it: gauge [Pa]."""
+    return spec.physics.cavitation_pressure - spec.physics.ambient_pressure
+
+
 def gas_release_entries(spec: CaseSpec) -> dict:
     """interPhaseChangeFoam's Kunz model as a one-way gas release: below pSat (the cavitation
     pressure, gauge like the solver's p) oil turns into gas at
@@ -339,7 +349,7 @@ def gas_release_entries(spec: CaseSpec) -> dict:
     Cv = 0.5 rho_oil k; Cc = 0: the gas is never dissolved back."""
     p = spec.physics
     return {"phaseChangeTwoPhaseMixture": "Kunz",
-            "pSat": p.cavitation_pressure - p.ambient_pressure,
+            "pSat": release_pressure_gauge(spec),
             "KunzCoeffs": {"UInf": 1.0, "tInf": 1.0, "Cc": 0.0,
                            "Cv": 0.5 * spec.oil_density * p.gas_release_rate}}
 
@@ -420,7 +430,10 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         hc=hc, contact_flow=spec.speed * hc * 2.0 * a,
         gap_mismatch=gap_mismatch(mesh, gap),
         oil_viscosity=spec.oil_viscosity, oil_density=spec.oil_density,
-        solver=spec.solver, ambient_pressure=spec.physics.ambient_pressure)
+        solver=spec.solver, ambient_pressure=spec.physics.ambient_pressure,
+        gas_release_rate=spec.physics.gas_release_rate if spec.scene == "gas-release" else 0.0,
+        release_pressure_gauge=release_pressure_gauge(spec),
+        air_solubility=spec.physics.air_solubility)
 
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))

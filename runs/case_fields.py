@@ -112,7 +112,8 @@ class Sample:
     def row(self) -> dict:
         keys = ("state", "inlet_meniscus_distance_over_a", "flooded_length_over_a",
                 "flooded_width_over_a", "wake_gas_length_over_a", "enclosed_bubbles",
-                "bubble_length_over_a", "bubble_volume_m3", "min_pressure_Pa")
+                "bubble_length_over_a", "bubble_volume_m3", "min_pressure_Pa",
+                "gas_release_m3_s")
         gas = ({} if self.gas_mass is None else
                {"gas_mass_kg": self.gas_mass, "gas_in_kg_s": self.gas_in,
                 "gas_out_kg_s": self.gas_out})
@@ -194,6 +195,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     p = (_uniform_or_list(FoamFieldFile(_complete(p_file)).internal_field, len(alpha))
          if p_file.exists() else None)
     pattern["min_pressure_Pa"] = _min_pressure(p, geom)
+    pattern["gas_release_m3_s"] = gas_release(p, alpha, structure.cell_volumes, geom)
     gas = _gas(folder, alpha, p, structure, geom) if geom.absolute_pressure else {}
     return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
                   pattern=pattern, oil_flux_exact=exact, oil_out_by_boundary=out_by_boundary,
@@ -260,6 +262,19 @@ def _bubble_volume(r: metrics.Raster, alpha: np.ndarray, structure: Structure,
     under = mask[iy, ix][structure.base_cell]
     gas = 1.0 - np.clip(alpha, 0.0, 1.0)
     return geom.mirror * float(np.sum(gas[under] * structure.cell_volumes[under]))
+
+
+def gas_release(p: np.ndarray | None, alpha: np.ndarray, cell_volumes: np.ndarray,
+                geom: CaseGeometry) -> float | None:
+    """Gas the gas-release scene makes [m3/s of gas at its (ambient) density, whole contact]:
+    k (pSat - p) alpha_oil per cell volume where p < pSat (Kunz's vaporisation term as
+    generator.case_writer.gas_release_entries writes it; ``p`` the solver's gauge pressure
+    [Pa] per cell). None for scenes that release nothing or when p was not written."""
+    if p is None or geom.gas_release_rate <= 0.0:
+        return None
+    deficit = np.maximum(geom.release_pressure_gauge - p, 0.0)
+    return geom.mirror * float(geom.gas_release_rate
+                               * np.sum(deficit * np.clip(alpha, 0.0, 1.0) * cell_volumes))
 
 
 def _min_pressure(p: np.ndarray | None, geom: CaseGeometry) -> float | None:

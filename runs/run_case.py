@@ -219,6 +219,39 @@ def mass_balance(history: list[case_fields.Sample]) -> dict:
     return out
 
 
+def dissolved_air_budget(history: list[case_fields.Sample], air_solubility: float,
+                         window: float) -> dict:
+    """The gas-release scene's gas against the air its oil could give up. The scene has no
+    budget of dissolved air (nothing in v1912 carries one without compiling), so this checks
+    after the fact whether one would have bound it, two ways:
+
+    - ``gas_release_over_dissolved_air``: the gas released between the first and the last
+      write (trapezoid over the writes; m3 at the gas's ambient density) over the Bunsen
+      coefficient ``air_solubility`` times all the oil that was in the gap at the first
+      write or came in since;
+    - ``gas_release_over_dissolved_inflow``: over the last ``window`` [s] (a transit), the
+      mean release rate over the mean rate at which the supply brings dissolved air in
+      (the steady-state budget; in a short run the first measure is diluted by the oil
+      already in the gap).
+
+    Above 1 the model made more gas than the oil could hold; below 1 is necessary, not
+    sufficient (only the oil that passes the suction can give its air up). Empty for scenes
+    that release nothing."""
+    rates = [s.pattern.get("gas_release_m3_s") for s in history]
+    if len(history) < 2 or any(r is None for r in rates):
+        return {}
+    t = np.array([s.time for s in history])
+    released = float(np.trapezoid(rates, t))
+    dissolved = air_solubility * (history[0].oil_volume
+                                  + float(np.trapezoid([s.oil_in for s in history], t)))
+    last = t >= t[-1] - window * (1.0 + 1e-9)
+    inflow = air_solubility * float(np.mean([s.oil_in for s in history if s.time >= t[last][0]]))
+    rate = float(np.mean(np.asarray(rates)[last]))
+    return {"gas_released_m3": released, "dissolved_air_m3": dissolved,
+            "gas_release_over_dissolved_air": released / dissolved if dissolved > 0 else None,
+            "gas_release_over_dissolved_inflow": rate / inflow if inflow > 0 else None}
+
+
 def run_case(case: str | Path, runtime: FoamRuntime | None = None,
              wall_limit: float | None = None,
              on_sample: Callable[[case_fields.Sample, CaseGeometry], None] | None = None,
@@ -401,6 +434,7 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "oil_outflow_off_outlet_fraction": (case_fields.off_outlet_share(last.oil_out_by_boundary)
                                             if last else None),
         **mass_balance(history),
+        **dissolved_air_budget(history, geom.air_solubility, geom.transit_time),
         "contact_flow_m3_s": geom.contact_flow,
         "contact_flow_over_inflow": (geom.contact_flow / last.oil_in
                                      if last and last.oil_in > 0 else None),

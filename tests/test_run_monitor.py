@@ -1,11 +1,14 @@
-"""The steady-state test and the mass balance of the run monitor, on synthetic histories."""
+"""The steady-state test, the mass balance and the dissolved-air budget of the run monitor, on
+synthetic histories and fields."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
-from runs.case_fields import Sample
-from runs.run_case import mass_balance, steady_test
+from generator.case_writer import CaseGeometry
+from runs.case_fields import Sample, gas_release
+from runs.run_case import dissolved_air_budget, mass_balance, steady_test
 
 
 def history(volumes, menisci, dt=0.01, state="I"):
@@ -79,3 +82,44 @@ def test_mass_balance_closes_for_a_consistent_history():
     assert mb["oil_mass_balance_error"] == pytest.approx(0.0, abs=1e-12)
     h[-1].oil_volume += 0.06     # 10 % of the oil carried in, lost or gained
     assert mass_balance(h)["oil_mass_balance_error"] == pytest.approx(0.1)
+
+
+def _geometry(**kw) -> CaseGeometry:
+    base = dict(a=1e-4, radius=0.01, speed=0.01, x_min=-1e-3, x_max=1e-3, y_max=1e-3,
+                island_radius=1.5e-4, symmetric=True, n_layers=4, cells=3, transit_time=0.1,
+                end_time=0.1, write_interval=0.01, max_delta_t=1e-4, capillary_limit="none",
+                min_cell_size=1e-5, island_gap=1e-6, hc=1e-8, contact_flow=0.0,
+                gap_mismatch=0.0, oil_viscosity=0.02, oil_density=870.0,
+                solver="interPhaseChangeFoam")
+    return CaseGeometry(**(base | kw))
+
+
+def test_gas_release_sums_kunz_vaporisation_below_the_release_pressure():
+    # k (pSat - p) alpha V per cell below pSat, doubled for the half domain: cell 1 is
+    # 10 kPa below pSat and half oil, cell 2 all oil at pSat, cell 3 above it
+    geom = _geometry(gas_release_rate=1e-3, release_pressure_gauge=-1e4)
+    p = np.array([-2e4, -1e4, 0.0])
+    alpha, volumes = np.array([0.5, 1.0, 1.0]), np.array([2e-12, 1e-12, 1e-12])
+    assert gas_release(p, alpha, volumes, geom) == pytest.approx(2 * 1e-3 * 1e4 * 0.5 * 2e-12)
+    assert gas_release(p, alpha, volumes, _geometry()) is None          # releases nothing
+    assert gas_release(None, alpha, volumes, geom) is None              # no p written
+
+
+def test_dissolved_air_budget_compares_the_release_with_all_the_oil():
+    # 1 m3 of oil at the start, 2 m3/s in for 1 s: 3 m3 of oil holding 0.1 x 3 m3 of air;
+    # 0.15 m3/s of gas released for 1 s is half of it, and 0.15 / (0.1 x 2) of the
+    # dissolved air the supply brings in per second
+    h = [Sample(time=t, oil_volume=1.0, oil_in=2.0, oil_out=2.0,
+                pattern={"gas_release_m3_s": 0.15}) for t in (0.0, 0.5, 1.0)]
+    b = dissolved_air_budget(h, air_solubility=0.1, window=0.6)
+    assert b["dissolved_air_m3"] == pytest.approx(0.3)
+    assert b["gas_released_m3"] == pytest.approx(0.15)
+    assert b["gas_release_over_dissolved_air"] == pytest.approx(0.5)
+    assert b["gas_release_over_dissolved_inflow"] == pytest.approx(0.75)
+    h[0].pattern["gas_release_m3_s"] = 1.0      # before the window: only the total sees it
+    b = dissolved_air_budget(h, air_solubility=0.1, window=0.6)
+    assert b["gas_released_m3"] == pytest.approx(0.25 * 1.15 + 0.5 * 0.15)
+    assert b["gas_release_over_dissolved_inflow"] == pytest.approx(0.75)
+    for s in h:
+        s.pattern["gas_release_m3_s"] = None                        # a scene without release
+    assert dissolved_air_budget(h, air_solubility=0.1, window=0.6) == {}
