@@ -241,12 +241,12 @@ def dissolved_air_budget(history: list[case_fields.Sample], air_solubility: floa
     if len(history) < 2 or any(r is None for r in rates):
         return {}
     t = np.array([s.time for s in history])
+    rates, oil_in = np.asarray(rates, dtype=float), np.array([s.oil_in for s in history])
     released = float(np.trapezoid(rates, t))
-    dissolved = air_solubility * (history[0].oil_volume
-                                  + float(np.trapezoid([s.oil_in for s in history], t)))
+    dissolved = air_solubility * (history[0].oil_volume + float(np.trapezoid(oil_in, t)))
     last = t >= t[-1] - window * (1.0 + 1e-9)
-    inflow = air_solubility * float(np.mean([s.oil_in for s in history if s.time >= t[last][0]]))
-    rate = float(np.mean(np.asarray(rates)[last]))
+    inflow = air_solubility * float(oil_in[last].mean())
+    rate = float(rates[last].mean())
     return {"gas_released_m3": released, "dissolved_air_m3": dissolved,
             "gas_release_over_dissolved_air": released / dissolved if dissolved > 0 else None,
             "gas_release_over_dissolved_inflow": rate / inflow if inflow > 0 else None}
