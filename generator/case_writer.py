@@ -27,7 +27,7 @@ from runs.foam_runtime import FoamRuntime
 from .case_spec import CaseSpec
 from .gap_source import load_gap
 from .mesh import (MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
-                   layer_fractions, split_patch, write_polymesh)
+                   layer_fractions, split_patch, wall_steps, write_polymesh)
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
 META = "ehlfoam"  # the case's own folder of generator outputs
@@ -78,6 +78,10 @@ class CaseGeometry:
     gas_release_rate: float = 0.0
     release_pressure_gauge: float = 0.0
     air_solubility: float = 0.09
+    #: median over the base cells of the wall-cell heights the ball surface steps across a
+    #: cell (generator.mesh.wall_steps); above BALL_WALL_STEPS_LIMIT a spurious film creeps
+    #: along the ball (0: not computed, a case written before it existed)
+    ball_wall_steps: float = 0.0
 
     @property
     def mirror(self) -> float:
@@ -393,6 +397,13 @@ def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int, solver: str) 
     (case / "Allrun").write_text(text)
 
 
+#: the median ball wall steps (generator.mesh.wall_steps) above which a case is flagged: the
+#: three levels give 7-9; 15-33 (thinner wall cells under the same in-plane cells) let a
+#: spurious oil film creep along the ball beside the flooded region and out through the side,
+#: narrowing it by 9-20 % (docs/cases.md, "Thinner wall cells")
+BALL_WALL_STEPS_LIMIT = 10.0
+
+
 def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | None = None,
                overwrite: bool = False) -> CaseGeometry:
     """Build the case of ``spec`` in ``out`` (atomically: built in a temporary sibling folder
@@ -410,8 +421,9 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
                         symmetric=d.symmetry == "half",
                         polar_radius=None if spec.mesh.polar_radius is None
                         else spec.mesh.polar_radius * a)
-    mesh = extrude(build_base_mesh(params, size_function(spec)), gap, level["n_layers"],
-                   level["wall_grading"])
+    base = build_base_mesh(params, size_function(spec))
+    mesh = extrude(base, gap, level["n_layers"], level["wall_grading"])
+    steps = float(np.median(wall_steps(base, gap, level["n_layers"], level["wall_grading"])))
     mesh, supply = with_supply_patch(spec, mesh)
     dx = level["size_rim"] * a
     dt = capillary_time_step(spec, dx)
@@ -433,7 +445,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         solver=spec.solver, ambient_pressure=spec.physics.ambient_pressure,
         gas_release_rate=spec.physics.gas_release_rate if spec.scene == "gas-release" else 0.0,
         release_pressure_gauge=release_pressure_gauge(spec),
-        air_solubility=spec.physics.air_solubility)
+        air_solubility=spec.physics.air_solubility, ball_wall_steps=steps)
 
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))

@@ -19,7 +19,8 @@ from foamlib import FoamFieldFile, FoamFile
 
 from ehl_precalc.spec import SpecError
 from generator.case_spec import make_case_spec
-from generator.case_writer import CaseExists, capillary_time_step, load_geometry, write_case
+from generator.case_writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_time_step,
+                                   load_geometry, write_case)
 from runs import case_fields
 from runs.foam_runtime import FoamRuntime
 from runs.run_case import OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, run_case
@@ -457,6 +458,24 @@ def test_cli_case_starts_from_another_run_case(tmp_path):
     start = case_fields._read_alpha(second / "0.orig" / "alpha.oil", structure)[0]
     assert np.allclose(start, final) and not np.allclose(
         start, case_fields._read_alpha(first / "0.orig" / "alpha.oil", structure)[0])
+
+
+def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path):
+    """Thinner wall cells under the same in-plane cells make the ball stair-step over many
+    wall-cell heights per cell, where a spurious film creeps along it: `ehlfoam case` says so
+    (and records the median steps); the small case's own layers do not."""
+    spec = tmp_path / "small.toml"
+    spec.write_text(_toml(SMALL))
+    runs = {}
+    for name, extra in (("own", []), ("thin", ["--set", "mesh.n_layers=12",
+                                               "--set", "mesh.wall_grading=40"])):
+        runs[name] = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(tmp_path / name),
+                                     *extra], capture_output=True, text=True)
+        assert runs[name].returncode == 0, runs[name].stderr
+    own, thin = (load_geometry(tmp_path / n).ball_wall_steps for n in ("own", "thin"))
+    assert 0.0 < own < BALL_WALL_STEPS_LIMIT < thin
+    assert "warning" not in runs["own"].stderr
+    assert "wall cells step" in runs["thin"].stderr and "mesh.n_layers" in runs["thin"].stderr
 
 
 def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):

@@ -492,6 +492,24 @@ def test_layer_fractions_graded_toward_both_walls():
     assert np.allclose(layer_fractions(5, 1.0), np.linspace(0, 1, 6))
 
 
+def test_wall_steps_count_the_ball_stair_steps():
+    """A square quad of side d under a ball sloping by g in x: the ball rises g d across it,
+    which is g d / (f_1 h_mean) wall cells of height f_1 h_mean; thinner wall cells (graded
+    layers) step over proportionally more of them."""
+    from generator.mesh import layer_fractions, wall_steps
+
+    d, h0, g = 1e-4, 1e-5, 0.05
+    base = BaseMesh(points=np.array([[0.0, 0.0], [d, 0.0], [d, d], [0.0, d]]),
+                    quads=np.array([[0, 1, 2, 3]]))
+    gap = lambda x, y: h0 + g * x  # noqa: E731
+    h_mean = h0 + g * d / 2
+    assert wall_steps(base, gap, 4)[0] == pytest.approx(g * d / (0.25 * h_mean))
+    wall = np.diff(layer_fractions(10, 8.0))[0]
+    assert wall_steps(base, gap, 10, 8.0)[0] / wall_steps(base, gap, 10)[0] == pytest.approx(
+        0.1 / wall)
+    assert wall_steps(base, lambda x, y: h0 + 0 * x, 4)[0] == 0.0      # a flat ball: none
+
+
 def test_split_patch_keeps_a_valid_mesh():
     from generator.mesh import split_patch
 
