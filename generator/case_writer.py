@@ -398,9 +398,9 @@ def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int, solver: str) 
 
 
 #: the median ball wall steps (generator.mesh.wall_steps) above which a case is flagged: the
-#: three levels give 7-9; 15-33 (thinner wall cells under the same in-plane cells) let a
-#: spurious oil film creep along the ball beside the flooded region and out through the side,
-#: narrowing it by 9-20 % (docs/cases.md, "Thinner wall cells")
+#: three levels give 7-9; at 15-90 (thinner wall cells under the same in-plane cells) a
+#: spurious oil film creeps along the ball beside the flooded region and 10-54 % of the
+#: outflow leaves through the side (docs/cases.md, "Thinner wall cells: the ball's stair-steps")
 BALL_WALL_STEPS_LIMIT = 10.0
 
 

@@ -88,7 +88,7 @@ def cmd_case(args: argparse.Namespace) -> int:
               f"{BALL_WALL_STEPS_LIMIT:g} a spurious oil film creeps along the ball): thinner "
               f"wall cells (mesh.n_layers, mesh.wall_grading) need finer in-plane cells "
               f"(mesh.resolution, mesh.size_rim, mesh.size_far); docs/cases.md, "
-              f"\"Thinner wall cells\"", file=sys.stderr)
+              f"\"Thinner wall cells: the ball's stair-steps\"", file=sys.stderr)
     return EXIT_OK
 
 
