@@ -408,11 +408,10 @@ def format_errors(err: ValidationError, root: type[BaseModel] = None) -> str:
 
 def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> CaseSpec:
     """Validate a case spec from nested data; ``overrides`` are dotted keys
-    (``{"contact.speed": 0.017}``) applied on top. Raises :class:`SpecError`."""
+    (``{"contact.speed": 0.017}``) applied on top; None clears an optional key
+    (``{"mesh.polar_radius": None}``: free quads). Raises :class:`SpecError`."""
     data = _deep_copy(data or {})
     for dotted, value in overrides.items():
-        if value is None:
-            continue
         node = data
         *parents, leaf = dotted.split(".")
         for p in parents:

@@ -93,9 +93,12 @@ def cmd_case(args: argparse.Namespace) -> int:
 
 
 def parse_value(text: str):
-    """A --set value: TOML scalar syntax (numbers, booleans, quoted or bare strings)."""
+    """A --set value: TOML scalar syntax (numbers, booleans, quoted or bare strings), or
+    ``none`` for an optional key's "not set" (e.g. ``mesh.polar_radius=none``: free quads)."""
     import tomllib
 
+    if text.strip().lower() == "none":
+        return None
     try:
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
@@ -189,7 +192,8 @@ def build_parser() -> argparse.ArgumentParser:
     case.add_argument("--out", required=True, help="case folder to write")
     case.add_argument("--set", action="append", metavar="KEY=VALUE",
                       help="override a spec value, e.g. --set contact.speed=0.017 "
-                           "--set mesh.resolution=coarse (repeatable)")
+                           "--set mesh.resolution=coarse; none clears an optional key, e.g. "
+                           "--set mesh.polar_radius=none (repeatable)")
     case.add_argument("--overwrite", action="store_true", help="replace an existing case")
     case.add_argument("--start-from", default=None, metavar="CASE",
                       help="start from the final fields of another run case (a converged "

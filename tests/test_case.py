@@ -22,6 +22,7 @@ from generator.case_spec import make_case_spec
 from generator.case_writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_time_step,
                                    load_geometry, write_case)
 from runs import case_fields
+from runs.cli import parse_value
 from runs.foam_runtime import FoamRuntime
 from runs.run_case import OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, run_case
 from tiny import SMALL
@@ -65,6 +66,21 @@ def test_bad_spec_fails_before_anything_is_written(tmp_path, table, text, expect
                           capture_output=True, text=True, cwd=ROOT)
     assert proc.returncode == 2, proc.stderr
     assert text in proc.stderr and expected in proc.stderr, proc.stderr
+    assert not out.exists()
+
+
+def test_set_none_clears_an_optional_key_and_is_refused_for_a_required_one(tmp_path):
+    """`--set KEY=none`: an optional key goes back to "not set" (the spec file's polar ring
+    off); a required key is refused by name before anything is written."""
+    spec = make_case_spec({"mesh": {"resolution": "coarse", "polar_radius": 6.8}},
+                          **{"mesh.polar_radius": parse_value("none")})
+    assert spec.mesh.polar_radius is None
+    path = tmp_path / "ring.toml"
+    path.write_text("[mesh]\npolar_radius = 6.8\n")
+    out = tmp_path / "case"
+    proc = subprocess.run([*EHLFOAM, "case", str(path), "--out", str(out),
+                           "--set", "contact.speed=none"], capture_output=True, text=True)
+    assert proc.returncode == 2 and "contact.speed" in proc.stderr, proc.stderr
     assert not out.exists()
 
 
