@@ -889,7 +889,8 @@ def wall_steps(base: BaseMesh, gap: GapFunction, n_layers: int,
     quad: (max h - min h over its nodes) / (f_1 h_mean), with f_1 the wall cell's share of
     the gap (:func:`layer_fractions`). Where the ball slopes (|grad h| ~ r / R), thin wall
     cells under wide quads stair-step along it; above ~10 steps a spurious oil film creeps
-    along the ball beside the flooded region (docs/cases.md, "Thinner wall cells: the ball's stair-steps")."""
+    along the ball beside the flooded region (docs/cases.md, "Thinner wall cells: the
+    ball's stair-steps")."""
     h = _gap_at_nodes(base, gap)[np.asarray(base.quads, np.int64)]
     wall = float(np.diff(layer_fractions(_check_n_layers(n_layers), wall_grading))[0])
     return (h.max(axis=1) - h.min(axis=1)) / (wall * h.mean(axis=1))
