@@ -447,6 +447,7 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "a_m": geom.a,
         "speed_m_s": geom.speed,
         "mesh_gap_mismatch": geom.gap_mismatch,
+        "ball_wall_steps": geom.ball_wall_steps,
     }
     if failed:
         log = case / geom.log_name

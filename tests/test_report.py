@@ -26,7 +26,7 @@ from PIL import Image
 from generator.case_spec import make_case_spec
 from generator.case_writer import load_geometry, write_case
 from runs.case_fields import time_folders
-from runs.report import add_parser, report, report_batch, report_case
+from runs.report import add_parser, report, report_batch, report_case, units
 from runs.report.charts import bubble_relation_x, fit_bubble_relation
 from runs.report.fields import load_fields
 from runs.report.side_view import cut_at_axis
@@ -92,6 +92,8 @@ def test_case_report_has_every_part(case_report, finished_case):
     metrics = json.loads((finished_case / "metrics.json").read_text())
     for key in ("oil_volume_m3", "inlet_meniscus_distance_over_a", "wall_s", "cells"):
         assert f"<td>{key}</td>" in html, key
+    unlabelled = [k for k in metrics if k not in units.METRICS and k not in units.METRICS_HIDDEN]
+    assert unlabelled == [], unlabelled                    # every key a label and a unit
     assert "<td>nl</td>" in html and "<td>mm/s</td>" in html
     assert f"{metrics['cells']:,}" in html
     assert "interFoam" in html and "OPENFOAM=" in html            # solver and build
