@@ -10,7 +10,6 @@ the case's history.csv at that write); a bare CASE shows the last write and its 
 
 from __future__ import annotations
 
-import csv
 import json
 import sys
 from pathlib import Path
@@ -22,6 +21,7 @@ sys.path.insert(0, str(ROOT))
 
 from generator.case_writer import load_geometry  # noqa: E402
 from runs import case_fields  # noqa: E402
+from runs.report.case_data import read_history  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -92,24 +92,16 @@ def _pick(arg: str) -> tuple[Path, float | None]:
 
 
 def _metrics_at(case: Path, t: float | None) -> dict:
-    """metrics.json (t None), or the history.csv row nearest time t [s], numbers parsed."""
+    """metrics.json (t None), or the history.csv row nearest time t [s] (None where empty)."""
     if t is None:
         f = case / "metrics.json"
         return json.loads(f.read_text()) if f.exists() else {}
-    f = case / "history.csv"
-    if not f.exists():
+    h = read_history(case / "history.csv")
+    if h is None:
         return {}
-    rows = list(csv.DictReader(f.open()))
-    if not rows:
-        return {}
-    row = min(rows, key=lambda r: abs(float(r["time_s"]) - t))
-    out: dict = {}
-    for k, v in row.items():
-        try:
-            out[k] = float(v)
-        except (TypeError, ValueError):
-            out[k] = v or None
-    return out
+    i = int(np.argmin(np.abs(h["time_s"] - t)))
+    return {k: (None if isinstance(v[i], float) and np.isnan(v[i]) else v[i])
+            for k, v in h.items()}
 
 
 if __name__ == "__main__":

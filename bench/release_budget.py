@@ -23,7 +23,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
-from generator.case_writer import load_geometry, load_spec_of, release_pressure_gauge  # noqa: E402
+from generator.case_writer import load_geometry, load_spec_of, release_geometry  # noqa: E402
 from runs import case_fields  # noqa: E402
 from runs.run_case import dissolved_air_budget  # noqa: E402
 
@@ -33,10 +33,9 @@ def budget(case: Path, solubility: float | None = None) -> dict:
     spec = load_spec_of(case)
     if spec.scene != "gas-release":
         raise SystemExit(f"release_budget: {case} is a {spec.scene!r} case, not gas-release")
-    geom = dataclasses.replace(
-        load_geometry(case), gas_release_rate=spec.physics.gas_release_rate,
-        release_pressure_gauge=release_pressure_gauge(spec),
-        air_solubility=spec.physics.air_solubility if solubility is None else solubility)
+    geom = dataclasses.replace(load_geometry(case), **release_geometry(spec))
+    if solubility is not None:
+        geom = dataclasses.replace(geom, air_solubility=solubility)
     structure = case_fields.Structure.load(case)
     history = [case_fields.sample(folder, structure, geom)
                for _, folder in case_fields.time_folders(case)]

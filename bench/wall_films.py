@@ -42,8 +42,7 @@ def films(case: Path) -> dict:
     _, folder = case_fields.time_folders(case)[-1]
     alpha = np.clip(case_fields._read_alpha(folder / "alpha.oil", st)[0], 0.0, 1.0)
     n = len(st.base_x)
-    column = np.bincount(st.base_cell, st.cell_volumes, minlength=n)
-    oil = np.bincount(st.base_cell, alpha * st.cell_volumes, minlength=n) / column
+    oil = st.gap_mean(alpha)                      # oil over the column's volume (its gap)
     mid = st.mid_gap(alpha, geom.n_layers)
     wall = {}
     for name, layer in (("disc", 0), ("ball", geom.n_layers - 1)):

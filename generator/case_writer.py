@@ -345,6 +345,16 @@ def release_pressure_gauge(spec: CaseSpec) -> float:
     return spec.physics.cavitation_pressure - spec.physics.ambient_pressure
 
 
+def release_geometry(spec: CaseSpec) -> dict:
+    """The :class:`CaseGeometry` fields of the gas release that the run's budget check reads:
+    k (0 unless the scene releases gas), the release pressure as pSat and the Bunsen
+    coefficient."""
+    p = spec.physics
+    return {"gas_release_rate": p.gas_release_rate if spec.scene == "gas-release" else 0.0,
+            "release_pressure_gauge": release_pressure_gauge(spec),
+            "air_solubility": p.air_solubility}
+
+
 def gas_release_entries(spec: CaseSpec) -> dict:
     """interPhaseChangeFoam's Kunz model as a one-way gas release: below pSat (the cavitation
     pressure, gauge like the solver's p) oil turns into gas at
@@ -443,9 +453,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         gap_mismatch=gap_mismatch(mesh, gap),
         oil_viscosity=spec.oil_viscosity, oil_density=spec.oil_density,
         solver=spec.solver, ambient_pressure=spec.physics.ambient_pressure,
-        gas_release_rate=spec.physics.gas_release_rate if spec.scene == "gas-release" else 0.0,
-        release_pressure_gauge=release_pressure_gauge(spec),
-        air_solubility=spec.physics.air_solubility, ball_wall_steps=steps)
+        **release_geometry(spec), ball_wall_steps=steps)
 
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))
