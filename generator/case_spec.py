@@ -12,7 +12,7 @@ units of the Hertzian radius a::
     lubricant = "HVI60"
 
     [supply]
-    mode = "layers"      # "flooded" (ample oil) or "layers"
+    mode = "layers"      # "flooded" (ample oil), "layers" or "submerged"
     disc_layer = 2e-6    # m, oil layer carried into the inlet on the disc
     ball_layer = 2e-6    # m, ... on the ball
     track_half_width = 3e-4   # m
@@ -66,7 +66,11 @@ class Supply(BaseModel):
     Attributes:
         mode: "flooded": the whole gap height on the track is oil at the inlet and the case
             starts from a puddle (ample oil); "layers": an oil layer on each surface, on the
-            track only, is carried in by the walls (a starved supply).
+            track only, is carried in by the walls (a starved supply); "submerged": the
+            contact runs in a bath, the domain starts full of oil and what flows in
+            through every open boundary is oil, so the only gas is what the scene makes
+            (gas-release scene; with it the gas may dissolve back,
+            physics.gas_dissolution_rate).
         disc_layer, ball_layer: oil layer thickness on the disc and on the ball at the
             inlet [m] ("layers" mode).
         track_half_width: half-width of the oil track at the inlet [m].
@@ -84,7 +88,7 @@ class Supply(BaseModel):
     """
 
     model_config = _STRICT
-    mode: Literal["flooded", "layers"] = "flooded"
+    mode: Literal["flooded", "layers", "submerged"] = "flooded"
     disc_layer: float = Field(2e-6, ge=0.0, le=1e-3)
     ball_layer: float = Field(2e-6, ge=0.0, le=1e-3)
     track_half_width: float = Field(3e-4, gt=0.0, le=0.1)
@@ -114,7 +118,13 @@ class Physics(BaseModel):
             positive floor, so the default is 1 kPa (sensitivity in docs/cavitation.md).
         gas_release_rate: [1/(Pa s)] of the gas-release scene: oil below the cavitation
             pressure releases gas at k (p_cav - p) volumes of gas per volume of oil per
-            second, which is never taken back (Kunz's model without its condensation term).
+            second (Kunz's vaporisation term).
+        gas_dissolution_rate: [1/s] of the gas-release scene: gas in a cell that also holds
+            oil, where the pressure is above the cavitation pressure, goes back into the oil
+            at C alpha^2 (1 - alpha) volumes per cell volume per second (alpha the oil
+            fraction; Kunz's condensation term, Cc with tInf = 1 s). 0, the default: the
+            gas never dissolves back. Only with supply.mode = "submerged": the scene has one
+            gas, and where outer air meets the oil it would dissolve the air too.
         air_solubility: Bunsen coefficient of air in the oil: volumes of air (at ambient
             pressure) a volume of oil saturated at ambient pressure holds dissolved; ~0.09
             for mineral oils. The gas-release scene has no budget of dissolved air; the run
@@ -140,6 +150,7 @@ class Physics(BaseModel):
     cavitation_pressure: float = Field(1e3, gt=0.0, le=1e5)
     oil_bulk_modulus: float | None = Field(None, gt=1e6, le=1e11)
     gas_release_rate: float = Field(1e-3, gt=0.0, le=1e3)
+    gas_dissolution_rate: float = Field(0.0, ge=0.0, le=1e7)
     air_solubility: float = Field(0.09, ge=0.0, le=1.0)
 
 
@@ -342,6 +353,12 @@ class CaseSpec(BaseModel):
         return self.physics.oil_density or self.contact.oil().rho0
 
     @property
+    def fills_domain(self) -> bool:
+        """Oil fills the domain at t = 0 and is what flows in through the open boundaries
+        (the single-phase scene, and a submerged supply)."""
+        return self.scene == "single-phase" or self.supply.mode == "submerged"
+
+    @property
     def solver(self) -> str:
         """The OpenFOAM application of the scene."""
         return SOLVERS[self.scene]
@@ -435,6 +452,13 @@ def _check_scene_options(spec: CaseSpec) -> None:
             f"invalid case spec: run.air_viscosity_factor = {spec.run.air_viscosity_factor:g} "
             f"does not apply to scene = \"gas-release\", whose air has the oil's kinematic "
             f"viscosity (leave it at {default:g})")
+    rate = spec.physics.gas_dissolution_rate
+    if rate > 0 and (spec.scene != "gas-release" or spec.supply.mode != "submerged"):
+        raise SpecError(
+            f"invalid case spec: physics.gas_dissolution_rate = {rate:g} 1/s needs scene = "
+            f"\"gas-release\" and supply.mode = \"submerged\" (here {spec.scene!r}, "
+            f"{spec.supply.mode!r}): the scene has one gas, and where outer air meets the oil "
+            f"it would dissolve the air too (valid range otherwise: 0)")
 
 
 def _check_supply_fits(spec: CaseSpec) -> None:

@@ -74,14 +74,19 @@ class CaseGeometry:
     solver: str = "interFoam"
     ambient_pressure: float = 1.013e5
     #: the gas-release scene's k [1/(Pa s)] (0: the scene releases nothing), its release
-    #: pressure as the solver's gauge pSat [Pa] and the oil's Bunsen coefficient for air
+    #: pressure as the solver's gauge pSat [Pa], the oil's Bunsen coefficient for air, and
+    #: the rate C [1/s] at which its gas dissolves back (0: never)
     gas_release_rate: float = 0.0
+    gas_dissolution_rate: float = 0.0
     release_pressure_gauge: float = 0.0
     air_solubility: float = 0.09
     #: median over the base cells of the wall-cell heights the ball surface steps across a
     #: cell (generator.mesh.wall_steps); above BALL_WALL_STEPS_LIMIT a spurious film creeps
     #: along the ball (0: not computed, a case written before it existed)
     ball_wall_steps: float = 0.0
+    #: the oil fraction of what flows in through the boundaries open to the outside: 0 (air)
+    #: but where oil fills the domain (single-phase scene, submerged supply)
+    open_inflow_oil: float = 0.0
 
     @property
     def mirror(self) -> float:
@@ -160,9 +165,9 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     """alpha.oil at t = 0: the supply layers on the track, a puddle of radius
     initial_puddle a around the contact (whole gap height) and a gas seed of radius
     initial_bubble a on the island's downstream rim; all oil for single-phase."""
-    if spec.scene == "single-phase":
-        return np.ones(len(mesh.cell_volumes))
     x, y = mesh.cell_centres[:, 0], mesh.cell_centres[:, 1]
+    if spec.scene == "single-phase":
+        return np.ones(len(x))
     level = spec.mesh.level()
     f = layer_fractions(level["n_layers"], level["wall_grading"])
     h = gap(x, y)
@@ -170,7 +175,7 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     on_track = ((np.abs(y) < spec.supply.track_half_width)
                 & (np.abs(y) >= spec.supply.track_inner_half_width))
     alpha = oil_fraction(spec, h * f[k], h * f[k + 1], h, on_track)
-    puddle = np.hypot(x, y) < spec.supply.initial_puddle * spec.a
+    puddle = spec.fills_domain | (np.hypot(x, y) < spec.supply.initial_puddle * spec.a)
     alpha = np.where(puddle, 1.0, alpha)
     rim = spec.domain.island_radius * spec.a
     seed = np.hypot(x - rim, y) < spec.supply.initial_bubble * spec.a
@@ -179,9 +184,10 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
 
 def supply_fraction(spec: CaseSpec, mesh: PolyMesh, patch: str = "inlet") -> np.ndarray:
     """Oil fraction of each face of ``patch`` in the supply: the part of the face inside the
-    oil layers (or the whole face, flooded) on the track; 0 elsewhere and for single-phase."""
+    oil layers (or the whole face, flooded) on the track; 0 elsewhere, and everywhere where
+    oil fills the domain (single-phase, submerged: the open boundaries bring oil in)."""
     faces = mesh.faces[mesh.patch_slice(patch)]
-    if spec.scene == "single-phase":
+    if spec.fills_domain:
         return np.zeros(len(faces))
     # a face is a vertical trapezoid: its bottom and top are the means of its two lower and
     # two upper corners, so that the supplied area is exact
@@ -253,7 +259,7 @@ def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, fraction: np.ndarra
         if len(supply):
             f.boundary_field["supply"]["value"] = (supply if len(supply) not in (3, 6, 9)
                                                    else _PLACEHOLDER)
-        if spec.scene == "single-phase":   # oil everywhere: oil is what flows in
+        if spec.fills_domain:   # oil everywhere: oil is what flows in
             f.boundary_field['"(outlet|side)"']["inletValue"] = 1.0
             f.boundary_field["inlet"]["value"] = 1.0
         if not geom.symmetric:
@@ -350,21 +356,25 @@ def release_geometry(spec: CaseSpec) -> dict:
     k (0 unless the scene releases gas), the release pressure as pSat and the Bunsen
     coefficient."""
     p = spec.physics
-    return {"gas_release_rate": p.gas_release_rate if spec.scene == "gas-release" else 0.0,
+    releases = spec.scene == "gas-release"
+    return {"gas_release_rate": p.gas_release_rate if releases else 0.0,
             "release_pressure_gauge": release_pressure_gauge(spec),
-            "air_solubility": p.air_solubility}
+            "air_solubility": p.air_solubility,
+            "gas_dissolution_rate": p.gas_dissolution_rate if releases else 0.0}
 
 
 def gas_release_entries(spec: CaseSpec) -> dict:
-    """interPhaseChangeFoam's Kunz model as a one-way gas release: below pSat (the cavitation
+    """interPhaseChangeFoam's Kunz model as a gas release: below pSat (the cavitation
     pressure, gauge like the solver's p) oil turns into gas at
     mdot = Cv rho_gas / (0.5 rho_oil UInf^2 tInf) (pSat - p) alpha_oil [kg/(m3 s)], i.e.
     k (pSat - p) volumes of gas per volume of oil per second with UInf = tInf = 1 and
-    Cv = 0.5 rho_oil k; Cc = 0: the gas is never dissolved back."""
+    Cv = 0.5 rho_oil k. Above pSat gas goes back into the oil at
+    mdot = Cc rho_gas / tInf alpha_oil^2 (1 - alpha_oil): Cc = physics.gas_dissolution_rate,
+    0 by default (the gas is never dissolved back)."""
     p = spec.physics
     return {"phaseChangeTwoPhaseMixture": "Kunz",
             "pSat": release_pressure_gauge(spec),
-            "KunzCoeffs": {"UInf": 1.0, "tInf": 1.0, "Cc": 0.0,
+            "KunzCoeffs": {"UInf": 1.0, "tInf": 1.0, "Cc": p.gas_dissolution_rate,
                            "Cv": 0.5 * spec.oil_density * p.gas_release_rate}}
 
 
@@ -453,7 +463,8 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         gap_mismatch=gap_mismatch(mesh, gap),
         oil_viscosity=spec.oil_viscosity, oil_density=spec.oil_density,
         solver=spec.solver, ambient_pressure=spec.physics.ambient_pressure,
-        **release_geometry(spec), ball_wall_steps=steps)
+        **release_geometry(spec), ball_wall_steps=steps,
+        open_inflow_oil=1.0 if spec.fills_domain else 0.0)
 
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))

@@ -113,7 +113,7 @@ class Sample:
         keys = ("state", "inlet_meniscus_distance_over_a", "flooded_length_over_a",
                 "flooded_width_over_a", "wake_gas_length_over_a", "enclosed_bubbles",
                 "bubble_length_over_a", "bubble_volume_m3", "min_pressure_Pa",
-                "gas_release_m3_s")
+                "gas_release_m3_s", "gas_dissolution_m3_s")
         gas = ({} if self.gas_mass is None else
                {"gas_mass_kg": self.gas_mass, "gas_in_kg_s": self.gas_in,
                 "gas_out_kg_s": self.gas_out})
@@ -169,9 +169,9 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     alpha, alpha_file = _read_alpha(folder / "alpha.oil", structure)
     volume = _oil_volume(alpha, structure, geom)
     # the oil flux MULES transported (alphaPhi0.oil); where the solver does not write it
-    # (interPhaseChangeFoam), phi times the face alpha, and no oil flowing in through the
-    # boundaries open to the air (their inletValue; the written face values of inflow faces
-    # there are not what was transported)
+    # (interPhaseChangeFoam), phi times the face alpha, and what flows in through the open
+    # boundaries times their inletValue (geom.open_inflow_oil: 0, air, but where oil fills
+    # the domain; the written face values of inflow faces there are not what was transported)
     oil_flux_file = folder / "alphaPhi0.oil"
     exact = oil_flux_file.exists()
     flux_bf = FoamFieldFile(oil_flux_file if exact else folder / "phi").boundary_field
@@ -182,7 +182,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
         if not exact:
             flux = flux * np.clip(_uniform_or_list(alpha_bf[name]["value"], size), 0.0, 1.0)
             if name != SUPPLY_PATCH:
-                flux = np.maximum(flux, 0.0)
+                flux = np.where(flux > 0.0, flux, flux * geom.open_inflow_oil)
         return flux
 
     q_in, q_out, out_by_boundary = _in_out(oil_flux, structure, geom)
@@ -196,6 +196,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
          if p_file.exists() else None)
     pattern["min_pressure_Pa"] = _min_pressure(p, geom)
     pattern["gas_release_m3_s"] = gas_release(p, alpha, structure.cell_volumes, geom)
+    pattern["gas_dissolution_m3_s"] = gas_dissolution(p, alpha, structure.cell_volumes, geom)
     gas = _gas(folder, alpha, p, structure, geom) if geom.absolute_pressure else {}
     return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
                   pattern=pattern, oil_flux_exact=exact, oil_out_by_boundary=out_by_boundary,
@@ -275,6 +276,20 @@ def gas_release(p: np.ndarray | None, alpha: np.ndarray, cell_volumes: np.ndarra
     deficit = np.maximum(geom.release_pressure_gauge - p, 0.0)
     return geom.mirror * float(geom.gas_release_rate
                                * np.sum(deficit * np.clip(alpha, 0.0, 1.0) * cell_volumes))
+
+
+def gas_dissolution(p: np.ndarray | None, alpha: np.ndarray, cell_volumes: np.ndarray,
+                    geom: CaseGeometry) -> float | None:
+    """Gas the gas-release scene dissolves back [m3/s of gas, whole contact]:
+    C alpha^2 (1 - alpha) per cell volume where p > pSat (Kunz's condensation term with
+    C = geom.gas_dissolution_rate; ``p`` the solver's gauge pressure [Pa] per cell). None
+    where nothing dissolves back or p was not written."""
+    if p is None or geom.gas_dissolution_rate <= 0.0:
+        return None
+    a = np.clip(alpha, 0.0, 1.0)
+    above = p > geom.release_pressure_gauge
+    return geom.mirror * float(geom.gas_dissolution_rate
+                               * np.sum((a * a * (1.0 - a) * cell_volumes)[above]))
 
 
 def _min_pressure(p: np.ndarray | None, geom: CaseGeometry) -> float | None:

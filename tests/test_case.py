@@ -57,6 +57,9 @@ def _copy(case: Path, tmp_path: Path) -> Path:
      "physics.gas_release_rate = 0.0", "0 < physics.gas_release_rate"),
     ("scene = \"gas-release\"\n[run]\nair_viscosity_factor = 20.0\n",
      "run.air_viscosity_factor = 20", "leave it at 100"),
+    ("scene = \"gas-release\"\n[physics]\ngas_dissolution_rate = 100.0\n",
+     "physics.gas_dissolution_rate = 100 1/s", 'supply.mode = "submerged"'),
+    ("[supply]\nmode = \"bath\"\n", "supply.mode = 'bath'", "'submerged'"),
 ])
 def test_bad_spec_fails_before_anything_is_written(tmp_path, table, text, expected):
     spec = tmp_path / "bad.toml"
@@ -386,6 +389,44 @@ def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
     assert u_supply.ndim == 2 and np.all(u_supply[:, 0] < spec.wall_speed)
 
 
+def test_submerged_gas_release_dissolves_its_gas_back(tmp_path):
+    """A submerged contact (supply.mode = "submerged": oil fills the domain and is what
+    flows in everywhere) in the gas-release scene: the only gas is what the suction
+    releases, and with physics.gas_dissolution_rate (Kunz's condensation term) it goes back
+    into the oil where the pressure is above the release pressure. Same release, with and
+    without dissolving back: less gas is left in the gap with it, the run reports the rate,
+    and the oil balance, with the oil flowing in through the open boundaries, closes."""
+    gas, rate = {}, 3e5
+    for c in (0.0, rate):
+        spec = make_case_spec({**SMALL, "scene": "gas-release",
+                               "supply": {**SMALL["supply"], "mode": "submerged"},
+                               "physics": {"cavitation_pressure": 9e4, "gas_release_rate": 1.0,
+                                           "gas_dissolution_rate": c},
+                               "run": {**SMALL["run"], "end_time": 2e-3}})
+        case = tmp_path / f"submerged_C{c:g}"
+        geom = write_case(spec, case)
+        assert geom.open_inflow_oil == 1.0 and geom.gas_dissolution_rate == c
+        with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
+            assert np.all(np.asarray(f.internal_field) == 1.0)          # full of oil
+            assert f.boundary_field['"(outlet|side)"']["inletValue"] == 1.0
+        structure = case_fields.Structure.load(case)
+        assert structure.patches.get("supply", (0, 0))[1] == 0          # no supply faces
+        with FoamFile(case / "constant" / "transportProperties") as f:
+            assert f["KunzCoeffs"]["Cc"] == c
+        m = run_case(case, wall_limit=120)
+        assert m["status"] == "finished" and m["end_reason"] == "end_time", m.get("log_tail")
+        assert m["oil_mass_balance_error"] < 0.01, m["oil_mass_balance_error"]
+        _, last = case_fields.time_folders(case)[-1]
+        alpha = np.clip(np.asarray(FoamFieldFile(last / "alpha.oil").internal_field), 0, 1)
+        gas[c] = float(np.sum((1.0 - alpha) * structure.cell_volumes))
+        if c > 0:
+            assert m["gas_dissolution_m3_s"] > 0.0, m
+        else:
+            assert m["gas_dissolution_m3_s"] is None, m
+    assert gas[0.0] > 0.0                                          # the suction released gas
+    assert gas[rate] < 0.8 * gas[0.0], gas
+
+
 def _last_velocity(case: Path) -> np.ndarray:
     _, last = case_fields.time_folders(case)[-1]
     return np.asarray(FoamFieldFile(last / "U").internal_field)
@@ -400,18 +441,16 @@ def test_gas_release_flow_does_not_remember_the_initial_air(tmp_path):
     gas-release scene's air has the oil's kinematic viscosity (CaseSpec.air_viscosity), so
     nothing remembers."""
     spec = make_case_spec({**SMALL, "scene": "gas-release",
+                           "supply": {**SMALL["supply"], "mode": "submerged"},
                            "run": {**SMALL["run"], "end_time": 2e-3}})
     velocities = {}
     for start in (0.0, 1.0):
         case = tmp_path / f"open_boundaries_start_{start:g}"
         write_case(spec, case)
         with FoamFile(case / "0.orig" / "alpha.oil") as f:
-            f["internalField"] = 1.0
             open_patches = f["boundaryField"]['"(outlet|side)"']
-            assert open_patches["value"] == 0.0
-            open_patches["inletValue"] = 1.0
+            assert open_patches["value"] == 0.0 and open_patches["inletValue"] == 1.0
             open_patches["value"] = start
-            f["boundaryField"]["inlet"]["value"] = 1.0       # fixed: oil enters there too
         with FoamFile(case / "constant" / "transportProperties") as f:
             assert f["air"]["nu"] == pytest.approx(f["oil"]["nu"])
         m = run_case(case, wall_limit=120)

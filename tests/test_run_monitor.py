@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from generator.case_writer import CaseGeometry
-from runs.case_fields import Sample, gas_release
+from runs.case_fields import Sample, gas_dissolution, gas_release
 from runs.run_case import dissolved_air_budget, mass_balance, steady_test
 
 
@@ -103,6 +103,19 @@ def test_gas_release_sums_kunz_vaporisation_below_the_release_pressure():
     assert gas_release(p, alpha, volumes, geom) == pytest.approx(2 * 1e-3 * 1e4 * 0.5 * 2e-12)
     assert gas_release(p, alpha, volumes, _geometry()) is None          # releases nothing
     assert gas_release(None, alpha, volumes, geom) is None              # no p written
+
+
+def test_gas_dissolution_sums_kunz_condensation_above_the_release_pressure():
+    # C alpha^2 (1 - alpha) V per cell above pSat, doubled for the half domain: cell 1 is
+    # below pSat (nothing), cell 2 two-thirds oil above it, cell 3 all oil (no gas to lose)
+    geom = _geometry(gas_release_rate=1e-3, release_pressure_gauge=-1e4,
+                     gas_dissolution_rate=100.0)
+    p = np.array([-2e4, 0.0, 0.0])
+    alpha, volumes = np.array([0.5, 2.0 / 3.0, 1.0]), np.array([1e-12, 3e-12, 1e-12])
+    expected = 2 * 100.0 * (4.0 / 27.0) * 3e-12
+    assert gas_dissolution(p, alpha, volumes, geom) == pytest.approx(expected)
+    assert gas_dissolution(p, alpha, volumes, _geometry(gas_release_rate=1e-3)) is None
+    assert gas_dissolution(None, alpha, volumes, geom) is None
 
 
 def test_dissolved_air_budget_compares_the_release_with_all_the_oil():

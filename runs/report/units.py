@@ -53,6 +53,8 @@ METRICS: dict[str, Unit] = {
     "oil_mass_balance_reference": ("Mass balance relative to", "", None),
     "oil_mass_balance_window_s": ("Mass balance window", "ms", 1e3),
     "gas_release_m3_s": ("Gas released (gas-release scene, at the gas's density)", "nl/s", 1e12),
+    "gas_dissolution_m3_s": ("Gas dissolved back (gas-release scene, at the gas's density)",
+                             "nl/s", 1e12),
     "gas_released_m3": ("Gas released, first to last write", "nl", 1e12),
     "dissolved_air_m3": ("Air the oil holds dissolved (all its oil)", "nl", 1e12),
     "gas_release_over_dissolved_air": ("Gas released / air the oil holds dissolved", "%", 100.0),
