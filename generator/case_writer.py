@@ -424,6 +424,19 @@ def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int, solver: str) 
 BALL_WALL_STEPS_LIMIT = 10.0
 
 
+def mesh_warnings(geom: CaseGeometry) -> list[str]:
+    """What is wrong with a written case's mesh though it runs: the ball's wall cells
+    stair-stepping above :data:`BALL_WALL_STEPS_LIMIT`. `ehlfoam case` prints these, and every
+    run records them in metrics.json (``warnings``), which a batch shows."""
+    if geom.ball_wall_steps <= BALL_WALL_STEPS_LIMIT:
+        return []
+    return [f"the ball's wall cells step {geom.ball_wall_steps:.1f} of their heights across a "
+            f"cell (median; the levels give 7-9, above {BALL_WALL_STEPS_LIMIT:g} a spurious "
+            f"oil film creeps along the ball): thinner wall cells (mesh.n_layers, "
+            f"mesh.wall_grading) need finer in-plane cells (mesh.resolution, mesh.size_rim, "
+            f"mesh.size_far); docs/cases.md, \"Thinner wall cells: the ball's stair-steps\""]
+
+
 def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | None = None,
                overwrite: bool = False) -> CaseGeometry:
     """Build the case of ``spec`` in ``out`` (atomically: built in a temporary sibling folder

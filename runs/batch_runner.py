@@ -158,7 +158,8 @@ class BatchRunner:
             wall = m.get("case_wall_s") or m.get("wall_s") or 0.0
             word = "kept" if result.get("skipped") else "finished"
             self.progress.log(f"{word:8s} {task.key}: state {m.get('state')}, "
-                              f"{m.get('end_reason')}, {wall:.0f} s")
+                              f"{m.get('end_reason')}, {wall:.0f} s"
+                              + (f"; warning: {m['warnings']}" if m.get("warnings") else ""))
         else:
             reason = result.get("reason") or m.get("reason") or status
             self.progress.log(f"{status:8s} {task.key}: {reason}")

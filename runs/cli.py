@@ -49,7 +49,7 @@ def cmd_case(args: argparse.Namespace) -> int:
     """Validate the spec, then build the case (precalc, mesh, OpenFOAM files)."""
     from ehl_precalc.spec import SpecError
     from generator.case_spec import load_case_spec, make_case_spec
-    from generator.case_writer import BALL_WALL_STEPS_LIMIT, CaseExists, write_case
+    from generator.case_writer import CaseExists, mesh_warnings, write_case
 
     overrides = dict(kv.split("=", 1) for kv in args.set or [])
     try:
@@ -82,13 +82,8 @@ def cmd_case(args: argparse.Namespace) -> int:
           f"transit {geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, "
           f"maxDeltaT {geom.max_delta_t:.3g} s ({geom.capillary_limit}), "
           f"gap mismatch {geom.gap_mismatch:.2%}, ball wall steps {geom.ball_wall_steps:.1f}")
-    if geom.ball_wall_steps > BALL_WALL_STEPS_LIMIT:
-        print(f"ehlfoam case: warning: the ball's wall cells step {geom.ball_wall_steps:.1f} of "
-              f"their heights across a cell (median; the levels give 7-9, above "
-              f"{BALL_WALL_STEPS_LIMIT:g} a spurious oil film creeps along the ball): thinner "
-              f"wall cells (mesh.n_layers, mesh.wall_grading) need finer in-plane cells "
-              f"(mesh.resolution, mesh.size_rim, mesh.size_far); docs/cases.md, "
-              f"\"Thinner wall cells: the ball's stair-steps\"", file=sys.stderr)
+    for warning in mesh_warnings(geom):
+        print(f"ehlfoam case: warning: {warning}", file=sys.stderr)
     return EXIT_OK
 
 

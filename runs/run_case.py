@@ -35,7 +35,8 @@ import numpy as np
 from foamlib import FoamFile
 
 from ehl_precalc.outputs import atomic_write_json, atomic_write_text
-from generator.case_writer import META, CaseGeometry, load_geometry, load_spec_of
+from generator.case_writer import (META, CaseGeometry, load_geometry, load_spec_of,
+                                   mesh_warnings)
 
 from . import case_fields
 from .foam_runtime import FoamRuntime
@@ -448,6 +449,7 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "speed_m_s": geom.speed,
         "mesh_gap_mismatch": geom.gap_mismatch,
         "ball_wall_steps": geom.ball_wall_steps,
+        "warnings": "; ".join(mesh_warnings(geom)),
     }
     if failed:
         log = case / geom.log_name

@@ -20,7 +20,7 @@ from foamlib import FoamFieldFile, FoamFile
 from ehl_precalc.spec import SpecError
 from generator.case_spec import make_case_spec
 from generator.case_writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_time_step,
-                                   load_geometry, write_case)
+                                   load_geometry, mesh_warnings, write_case)
 from runs import case_fields
 from runs.cli import parse_value
 from runs.foam_runtime import FoamRuntime
@@ -531,6 +531,15 @@ def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path)
     assert 0.0 < own < BALL_WALL_STEPS_LIMIT < thin
     assert "warning" not in runs["own"].stderr
     assert "wall cells step" in runs["thin"].stderr and "mesh.n_layers" in runs["thin"].stderr
+    # every run records it in metrics.json, which a batch's log and results.csv show
+    warnings = mesh_warnings(load_geometry(tmp_path / "thin"))
+    assert [f"ehlfoam case: warning: {w}" for w in warnings] == [
+        ln for ln in runs["thin"].stderr.splitlines() if "warning" in ln]
+    assert mesh_warnings(load_geometry(tmp_path / "own")) == []
+    with FoamFile(tmp_path / "thin" / "system" / "controlDict") as f:
+        f["endTime"] = 1e-4
+    m = run_case(tmp_path / "thin", wall_limit=120)
+    assert m["status"] == "finished" and m["warnings"] == "; ".join(warnings), m
 
 
 def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):

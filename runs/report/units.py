@@ -60,6 +60,7 @@ METRICS: dict[str, Unit] = {
     "gas_release_over_dissolved_air": ("Gas released / air the oil holds dissolved", "%", 100.0),
     "gas_release_over_dissolved_inflow": ("Gas release / dissolved air the supply brings, "
                                           "last transit", "%", 100.0),
+    "warnings": ("Warnings (mesh)", "", None),
     "ball_wall_steps": ("Ball wall steps per cell (median; above 10 a film creeps)", "", 1.0),
     "contact_flow_m3_s": ("Flow through the contact, u hc 2a", "nl/s", 1e12),
     "contact_flow_over_inflow": ("Contact flow / oil inflow", "%", 100.0),
