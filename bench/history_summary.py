@@ -26,6 +26,9 @@ from runs.report.case_data import read_history  # noqa: E402
 #: history.csv columns summarised over the last transit.
 TRACKED = ("inlet_meniscus_distance_over_a", "flooded_length_over_a", "flooded_width_over_a",
            "bubble_length_over_a", "oil_volume_m3")
+#: ... and these where the run wrote them (the gas scenes; older histories lack some)
+TRACKED_IF_WRITTEN = ("bubble_volume_m3", "min_pressure_Pa", "gas_release_m3_s",
+                      "gas_dissolution_m3_s")
 
 
 def summarise(case: str | Path) -> dict:
@@ -38,7 +41,8 @@ def summarise(case: str | Path) -> dict:
     opened = next((float(ti) for ti, st in zip(t, states) if st == "II"), None)
     last = t >= t[-1] - transit * (1 + 1e-9)
     window = {}
-    for key in TRACKED:   # NaN: not found at that write (the meniscus at the edge)
+    written = [k for k in TRACKED_IF_WRITTEN if k in h and np.isfinite(h[k]).any()]
+    for key in (*TRACKED, *written):   # NaN: not found at that write (the meniscus at the edge)
         v = h[key][last]
         v = v[np.isfinite(v)]
         window[key] = ({"mean": float(v.mean()), "min": float(v.min()), "max": float(v.max()),

@@ -53,8 +53,8 @@ def main(argv=None) -> int:
         m = _metrics_at(case, None if at is None else t)
         spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
         sup = spec["supply"]
-        supply = ("flooded" if sup["mode"] == "flooded"
-                  else f"layers {sup['disc_layer'] * 1e6:g}+{sup['ball_layer'] * 1e6:g} um")
+        supply = (f"layers {sup['disc_layer'] * 1e6:g}+{sup['ball_layer'] * 1e6:g} um"
+                  if sup["mode"] == "layers" else sup["mode"])
         fmt = lambda v: "-" if v is None else f"{v:.2f}"  # noqa: E731
         scene = spec.get("scene", "interface")
         if scene == "gas-release":

@@ -15,7 +15,7 @@ cases under ``runs/NAME/``)::
     speed_mm_s = [5, 8, 12, 17, 25]    # mm/s  (or a range: {start = 5, stop = 25, num = 5})
     temperature_C = [40]               # C
     load_N = [20]                      # N
-    supply = [1, 2, 4, "flooded"]      # um of oil on disc and ball each, "flooded",
+    supply = [1, 2, 4, "flooded"]      # um of oil on disc and ball each, "flooded", "submerged",
                                        # or {disc_um = 1, ball_um = 2}
     resolution = ["coarse"]            # coarse | medium | fine
 
@@ -74,19 +74,23 @@ RANGE_HELP = ("a list [5, 8] or a range {start = 5, stop = 25, num = 5} "
 
 
 # ------------------------------------------------------------------ values
+#: supplies given by their mode alone (no layer thicknesses)
+WHOLE_GAP_SUPPLIES = ("flooded", "submerged")
+
 @dataclass(frozen=True)
 class SupplyChoice:
-    """One oil supply: ``mode`` "layers" (disc and ball layers [m]) or "flooded"."""
+    """One oil supply: ``mode`` "layers" (disc and ball layers [m]), "flooded" or
+    "submerged" (generator.case_spec.Supply)."""
 
-    mode: Literal["layers", "flooded"]
+    mode: Literal["layers", "flooded", "submerged"]
     disc_layer: float | None = None
     ball_layer: float | None = None
 
     @property
     def label(self) -> str:
-        """"2um", "1+2um" (disc+ball) or "flooded"."""
-        if self.mode == "flooded":
-            return "flooded"
+        """"2um", "1+2um" (disc+ball), "flooded" or "submerged"."""
+        if self.mode in WHOLE_GAP_SUPPLIES:
+            return self.mode
         d, b = _um(self.disc_layer), _um(self.ball_layer)
         return f"{d}um" if d == b else f"{d}+{b}um"
 
@@ -169,8 +173,8 @@ def _numbers(raw: Any) -> list[float]:
 
 
 def _supply_item(raw: Any) -> SupplyChoice:
-    if raw == "flooded":
-        return SupplyChoice("flooded")
+    if raw in WHOLE_GAP_SUPPLIES:
+        return SupplyChoice(raw)
     if _number(raw):
         return SupplyChoice("layers", raw * 1e-6, raw * 1e-6)
     if isinstance(raw, dict) and set(raw) <= {"disc_um", "ball_um"} and raw:
@@ -178,7 +182,8 @@ def _supply_item(raw: Any) -> SupplyChoice:
         if _number(d) and _number(b):
             return SupplyChoice("layers", d * 1e-6, b * 1e-6)
     raise ValueError(f"supply item {raw!r}: valid are a layer thickness in um on disc and ball "
-                     "(a number, e.g. 2), \"flooded\", or {disc_um = 1, ball_um = 2}")
+                     "(a number, e.g. 2), \"flooded\", \"submerged\", or "
+                     "{disc_um = 1, ball_um = 2}")
 
 
 def _supplies(raw: Any) -> list[SupplyChoice]:
@@ -397,7 +402,7 @@ def _fmt(v: float, width: int = 0, decimals: int = 0) -> str:
 def case_id(params: dict[str, Any]) -> str:
     """A readable id, e.g. ``u08.0_s2um_T40_F20_coarse``."""
     supply = params["supply_label"]
-    s = "flooded" if supply == "flooded" else f"s{supply}"
+    s = supply if supply in WHOLE_GAP_SUPPLIES else f"s{supply}"
     return (f"u{_fmt(params['speed_mm_s'], 2, 1)}_{s}_T{_fmt(params['temperature_C'])}"
             f"_F{_fmt(params['load_N'])}_{params['resolution']}")
 

@@ -62,11 +62,12 @@ def test_ranges_lists_and_scalars():
 def test_ids_params_and_si_specs():
     plan = _plan({"base": {"mesh": {"resolution": "coarse"}},
                   "sweep": {"speed_mm_s": [8, 8.25], "supply": [2, "flooded",
-                                                                {"disc_um": 1, "ball_um": 3}]}})
+                                                                {"disc_um": 1, "ball_um": 3},
+                                                                "submerged"]}})
     ids = [pc.id for pc in plan]
-    assert ids[:3] == ["u08.0_s2um_T40_F20_coarse", "u08.0_flooded_T40_F20_coarse",
-                       "u08.0_s1+3um_T40_F20_coarse"]
-    assert "u08.25_s2um_T40_F20_coarse" in ids and len(set(ids)) == len(ids) == 6
+    assert ids[:4] == ["u08.0_s2um_T40_F20_coarse", "u08.0_flooded_T40_F20_coarse",
+                       "u08.0_s1+3um_T40_F20_coarse", "u08.0_submerged_T40_F20_coarse"]
+    assert "u08.25_s2um_T40_F20_coarse" in ids and len(set(ids)) == len(ids) == 8
     pc = plan[0]
     assert pc.params == {"speed_mm_s": 8.0, "temperature_C": 40.0, "load_N": 20.0,
                          "supply": "layers", "disc_layer_um": 2.0, "ball_layer_um": 2.0,
@@ -76,6 +77,7 @@ def test_ids_params_and_si_specs():
     assert pc.spec.name == pc.id and pc.ramp is None
     flooded = plan[1]
     assert flooded.spec.supply.mode == "flooded" and flooded.params["disc_layer_um"] is None
+    assert plan[3].spec.supply.mode == "submerged" and plan[3].spec.fills_domain
     assert pc.to_json() == {"id": pc.id, "params": pc.params, "ramp": None}
 
 
