@@ -110,6 +110,10 @@ class Physics(BaseModel):
         interface_compression: interFoam's cAlpha (1, the default, keeps the meniscus sharp;
             0 gives 3-15x smaller spurious currents in the oil but smears the
             interface over a few transits: docs/cases.md).
+        isotropic_compression: interFoam's icAlpha: the share of the compression velocity
+            taken from the local speed |U| instead of the flux through each face (0, the
+            default: all from the face flux, so a meniscus lying along the flow is hardly
+            compressed; 1: every face of it as hard).
         ambient_pressure: [Pa, absolute] at the open boundaries (cavitating scene; the
             interface scene works in gauge pressure and adds it only to report one).
         cavitation_pressure: [Pa, absolute] the pressure floor of the cavitating scene
@@ -146,6 +150,7 @@ class Physics(BaseModel):
     air_viscosity: float = Field(1.8e-5, gt=0.0, le=1.0)
     viscosity_factor: float = Field(1.0, gt=0.0, le=1e3)
     interface_compression: float = Field(1.0, ge=0.0, le=4.0)
+    isotropic_compression: float = Field(0.0, ge=0.0, le=1.0)
     ambient_pressure: float = Field(1.013e5, gt=1e3, le=1e7)
     cavitation_pressure: float = Field(1e3, gt=0.0, le=1e5)
     oil_bulk_modulus: float | None = Field(None, gt=1e6, le=1e11)

@@ -325,6 +325,7 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
         f["maxDeltaT"] = geom.max_delta_t
     with FoamFile(case / "system" / "fvSolution") as f:
         f["solvers"]['"alpha.oil.*"']["cAlpha"] = spec.physics.interface_compression
+        f["solvers"]['"alpha.oil.*"']["icAlpha"] = spec.physics.isotropic_compression
         f["PIMPLE"]["nCorrectors"] = spec.run.pressure_correctors
     with FoamFile(case / "system" / "decomposeParDict") as f:
         f["numberOfSubdomains"] = spec.run.n_procs

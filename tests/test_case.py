@@ -122,16 +122,22 @@ def test_case_is_complete_and_runs_by_hand_layout(small_case):
 
 
 def test_time_step_options_reach_the_dictionaries(tmp_path):
-    """run.max_courant, max_alpha_courant, pressure_correctors and capillary_safety are what
+    """run.max_courant, max_alpha_courant, pressure_correctors, capillary_safety and the
+    interface compression (physics.interface_compression, isotropic_compression) are what
     controlDict and fvSolution say; the capillary limit scales with its safety factor."""
     spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "max_courant": 0.7,
                                             "max_alpha_courant": 0.6, "pressure_correctors": 2,
-                                            "capillary_safety": 1.5}})
+                                            "capillary_safety": 1.5},
+                           "physics": {"interface_compression": 0.25,
+                                       "isotropic_compression": 1.0}})
     geom = write_case(spec, tmp_path / "opts")
     with FoamFile(tmp_path / "opts" / "system" / "controlDict") as f:
         assert (f["maxCo"], f["maxAlphaCo"]) == (0.7, 0.6)
         assert f["maxDeltaT"] == pytest.approx(geom.max_delta_t)
-    assert FoamFile(tmp_path / "opts" / "system" / "fvSolution")["PIMPLE"]["nCorrectors"] == 2
+    fv_solution = FoamFile(tmp_path / "opts" / "system" / "fvSolution")
+    assert fv_solution["PIMPLE"]["nCorrectors"] == 2
+    alpha = fv_solution["solvers"]['"alpha.oil.*"']
+    assert (alpha["cAlpha"], alpha["icAlpha"]) == (0.25, 1.0)
     dx = geom.min_cell_size
     assert geom.max_delta_t == pytest.approx(min(capillary_time_step(spec, dx),
                                                  geom.write_interval))
