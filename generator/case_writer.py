@@ -164,10 +164,11 @@ def oil_fraction(spec: CaseSpec, z_lo, z_hi, gap_h, on_track) -> np.ndarray:
 def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     """alpha.oil at t = 0: the supply layers on the track, a puddle of radius
     initial_puddle a around the contact (whole gap height) and a gas seed of radius
-    initial_bubble a on the island's downstream rim; all oil for single-phase."""
-    x, y = mesh.cell_centres[:, 0], mesh.cell_centres[:, 1]
+    initial_bubble a on the island's downstream rim; all oil for single-phase, and all oil
+    but the seed for a submerged supply."""
     if spec.scene == "single-phase":
-        return np.ones(len(x))
+        return np.ones(len(mesh.cell_volumes))
+    x, y = mesh.cell_centres[:, 0], mesh.cell_centres[:, 1]
     level = spec.mesh.level()
     f = layer_fractions(level["n_layers"], level["wall_grading"])
     h = gap(x, y)
