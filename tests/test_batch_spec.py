@@ -122,3 +122,19 @@ def test_shipped_batch_specs_expand(name, n_cases):
         assert len({pc.params["disc_layer_um"] for pc in sweep}) >= 3
         directions = {pc.ramp["direction"] for pc in plan if pc.ramp}
         assert directions == {"up", "down"}
+
+
+@pytest.mark.parametrize("path", sorted((Path(__file__).resolve().parent.parent / "runs")
+                                        .glob("*.toml")), ids=lambda p: p.name)
+def test_tracked_specs_are_valid(path):
+    """Every spec under runs/ that the docs tell users to run is a valid case spec, or a batch
+    spec that expands into valid case specs: a renamed or retired key fails here, not in a
+    user's hands."""
+    from ehl_precalc.spec import read_toml
+    from generator.case_spec import load_case_spec
+
+    data = read_toml(path)
+    if {"sweep", "ramp", "base"} & set(data):
+        assert expand(parse_batch_spec(data, str(path)))
+    else:
+        assert load_case_spec(path).name
