@@ -25,21 +25,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from foamlib import FoamFieldFile  # noqa: E402
-
 from bench.common import save  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
 from runs import case_fields  # noqa: E402
-
-
-def _volume_flux(folder: Path, structure: case_fields.Structure,
-                 geom) -> tuple[float, float]:
-    """Total volume flux in and out [m3/s, whole contact] through the open boundaries."""
-    phi = FoamFieldFile(folder / "phi").boundary_field
-    q_in, q_out, _ = case_fields._in_out(
-        lambda name, size: case_fields._uniform_or_list(phi[name]["value"], size),
-        structure, geom)
-    return q_in, q_out
 
 
 def balance(case: Path, start_transits: float = 0.0) -> dict:
@@ -54,7 +42,7 @@ def balance(case: Path, start_transits: float = 0.0) -> dict:
         if t < start_transits * geom.transit_time - 1e-12:
             continue
         s = case_fields.sample(folder, structure, geom)
-        q_in, q_out = _volume_flux(folder, structure, geom)
+        q_in, q_out = case_fields.volume_flux(folder, structure, geom)
         rows.append((t, total - s.oil_volume, s.pattern["gas_release_m3_s"] or 0.0,
                      s.pattern.get("gas_dissolution_m3_s") or 0.0,
                      q_in - s.oil_in, q_out - s.oil_out))

@@ -228,6 +228,15 @@ def _in_out(face_flux, structure: Structure,
     return geom.mirror * q_in, sum(out_by_patch.values()), out_by_patch
 
 
+def volume_flux(folder: Path, structure: Structure, geom: CaseGeometry) -> tuple[float, float]:
+    """The total volume flux [m3/s, whole contact] in and out through the open boundaries at
+    one written time, from its phi (oil and gas together)."""
+    phi = FoamFieldFile(_complete(folder / "phi")).boundary_field
+    q_in, q_out, _ = _in_out(lambda name, size: _uniform_or_list(phi[name]["value"], size),
+                             structure, geom)
+    return q_in, q_out
+
+
 def _gas(folder: Path, alpha: np.ndarray, p: np.ndarray, structure: Structure,
          geom: CaseGeometry) -> dict:
     """Air mass [kg] in the gap and its mass fluxes [kg/s] in and out through the open

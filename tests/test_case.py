@@ -425,6 +425,9 @@ def test_submerged_gas_release_dissolves_its_gas_back(tmp_path):
         _, last = case_fields.time_folders(case)[-1]
         alpha = np.clip(np.asarray(FoamFieldFile(last / "alpha.oil").internal_field), 0, 1)
         gas[c] = float(np.sum((1.0 - alpha) * structure.cell_volumes))
+        # all that flows in is oil, and the monitor counts it so
+        q_in, _ = case_fields.volume_flux(last, structure, geom)
+        assert q_in > 0 and m["oil_inflow_m3_s"] == pytest.approx(q_in, rel=1e-9)
         if c > 0:
             assert m["gas_dissolution_m3_s"] > 0.0, m
         else:
