@@ -458,7 +458,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
                         else spec.mesh.polar_radius * a)
     base = build_base_mesh(params, size_function(spec))
     mesh = extrude(base, gap, level["n_layers"], level["wall_grading"])
-    steps = float(np.median(wall_steps(base, gap, level["n_layers"], level["wall_grading"])))
+    steps = float(np.median(wall_steps(base, mesh)))
     mesh, supply = with_supply_patch(spec, mesh)
     dx = level["size_rim"] * a
     dt = capillary_time_step(spec, dx)

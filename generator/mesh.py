@@ -883,17 +883,17 @@ def extrude(base: BaseMesh, gap: GapFunction, n_layers: int,
                     base_cell=cells // L, layer=cells % L, face_centres=fc, face_areas=sf)
 
 
-def wall_steps(base: BaseMesh, gap: GapFunction, n_layers: int,
-               wall_grading: float = 1.0) -> np.ndarray:
+def wall_steps(base: BaseMesh, mesh: PolyMesh) -> np.ndarray:
     """Per base quad, how many wall-cell heights the ball surface rises or falls across the
-    quad: (max h - min h over its nodes) / (f_1 h_mean), with f_1 the wall cell's share of
-    the gap (:func:`layer_fractions`). Where the ball slopes (|grad h| ~ r / R), thin wall
-    cells under wide quads stair-step along it; above ~10 steps a spurious oil film creeps
-    along the ball beside the flooded region (docs/cases.md, "Thinner wall cells: the
-    ball's stair-steps")."""
-    h = _gap_at_nodes(base, gap)[np.asarray(base.quads, np.int64)]
-    wall = float(np.diff(layer_fractions(_check_n_layers(n_layers), wall_grading))[0])
-    return (h.max(axis=1) - h.min(axis=1)) / (wall * h.mean(axis=1))
+    quad: (max h - min h over its nodes) / (mean wall-cell height over its nodes), read off
+    ``mesh = extrude(base, ...)`` (its node columns: disc, the wall cell's top, ..., ball).
+    Where the ball slopes (|grad h| ~ r / R), thin wall cells under wide quads stair-step
+    along it; above ~10 steps a spurious oil film creeps along the ball beside the flooded
+    region (docs/cases.md, "Thinner wall cells: the ball's stair-steps")."""
+    quads = np.asarray(base.quads, np.int64)
+    column_z = mesh.points[:, 2].reshape(len(base.points), -1)   # extrude's node order
+    h, wall = column_z[quads, -1], column_z[quads, 1]
+    return (h.max(axis=1) - h.min(axis=1)) / wall.mean(axis=1)
 
 
 def split_patch(mesh: PolyMesh, name: str, select: np.ndarray, new_name: str,

@@ -500,14 +500,18 @@ def test_wall_steps_count_the_ball_stair_steps():
 
     d, h0, g = 1e-4, 1e-5, 0.05
     base = BaseMesh(points=np.array([[0.0, 0.0], [d, 0.0], [d, d], [0.0, d]]),
-                    quads=np.array([[0, 1, 2, 3]]))
+                    quads=np.array([[0, 1, 2, 3]]),
+                    edges={"side": np.array([[0, 1], [1, 2], [2, 3], [3, 0]])})
     gap = lambda x, y: h0 + g * x  # noqa: E731
     h_mean = h0 + g * d / 2
-    assert wall_steps(base, gap, 4)[0] == pytest.approx(g * d / (0.25 * h_mean))
+
+    def steps(gap, n_layers, grading=1.0):
+        return wall_steps(base, extrude(base, gap, n_layers, grading))[0]
+
+    assert steps(gap, 4) == pytest.approx(g * d / (0.25 * h_mean))
     wall = np.diff(layer_fractions(10, 8.0))[0]
-    assert wall_steps(base, gap, 10, 8.0)[0] / wall_steps(base, gap, 10)[0] == pytest.approx(
-        0.1 / wall)
-    assert wall_steps(base, lambda x, y: h0 + 0 * x, 4)[0] == 0.0      # a flat ball: none
+    assert steps(gap, 10, 8.0) / steps(gap, 10) == pytest.approx(0.1 / wall)
+    assert steps(lambda x, y: h0 + 0 * x, 4) == 0.0                    # a flat ball: none
 
 
 def test_split_patch_keeps_a_valid_mesh():
