@@ -27,7 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
-from common import solver_cpu_s, spec_option  # noqa: E402
+from common import apply_edits, foam_edit, solver_cpu_s, spec_option  # noqa: E402
 from runs.ramp import seed_from_previous  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
@@ -52,6 +52,7 @@ def one(level: str, args: argparse.Namespace, previous: str | None = None) -> di
     case = Path(args.work) / args.tag / level
     t0 = time.perf_counter()
     write_case(spec, case, overwrite=True)
+    apply_edits(case, args.edit)
     if previous is not None:
         seed_from_previous(case, case.parent / previous)
     build_s = time.perf_counter() - t0
@@ -89,6 +90,11 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], type=spec_option, metavar="KEY=VALUE",
                     help="a spec option, e.g. run.max_courant=1 or supply.initial_puddle=5 "
                          "(repeatable)")
+    ap.add_argument("--edit", action="append", default=[], type=foam_edit,
+                    metavar="FILE:KEY/SUBKEY=VALUE",
+                    help="change an entry of a system/ file of every case (e.g. "
+                         "fvSchemes:snGradSchemes/default=uncorrected): to measure what the "
+                         "spec does not offer")
     ap.add_argument("--work", default=str(ROOT / "runs" / "bench"))
     args = ap.parse_args(argv)
     previous = {level: (args.levels[i - 1] if i and args.sequence else None)

@@ -83,3 +83,45 @@ def spec_option(text: str) -> tuple[str, Any]:
     if not sep or not key:
         raise argparse.ArgumentTypeError(f"--set wants KEY=VALUE, got {text!r}")
     return key, parse_value(value)
+
+
+def foam_edit(text: str) -> tuple[str, tuple[str, ...], object]:
+    """``FILE:KEY/SUBKEY=VALUE`` of a ``system/`` file entry; VALUE is a word, a number or
+    several words (a scheme); an argparse ``type``."""
+    target, sep, value = text.partition("=")
+    file, colon, path = target.partition(":")
+    if not sep or not colon or not path:
+        raise argparse.ArgumentTypeError(f"--edit wants FILE:KEY/SUBKEY=VALUE, got {text!r}")
+    words = value.split()
+    if len(words) > 1:
+        return file, tuple(path.split("/")), tuple(words)
+    for kind in (int, float):
+        try:
+            return file, tuple(path.split("/")), kind(value)
+        except ValueError:
+            pass
+    return file, tuple(path.split("/")), value
+
+
+def apply_edits(case: Path, edits: list, solver: str = "") -> None:
+    """Apply ``--edit`` entries (:func:`foam_edit`) and, where given, another solver of the
+    interFoam family (``interIsoFoam``) to a written case."""
+    import dataclasses
+
+    from foamlib import FoamFile
+
+    from ehl_precalc.outputs import atomic_write_json
+    from generator.case_writer import META, load_geometry
+
+    for file, keys, value in edits:
+        with FoamFile(case / "system" / file) as f:
+            entry = f
+            for key in keys[:-1]:
+                entry = entry[key]
+            entry[keys[-1]] = value
+    geom = load_geometry(case)
+    if solver and solver != geom.solver:
+        with FoamFile(case / "system" / "controlDict") as f:
+            f["application"] = solver
+        geom = dataclasses.replace(geom, solver=solver)
+        atomic_write_json(case / META / "geometry.json", dataclasses.asdict(geom))

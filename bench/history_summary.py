@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
 
 from bench.common import RESULTS, save  # noqa: E402
 from runs.case_fields import off_outlet_share  # noqa: E402
@@ -57,6 +58,8 @@ def summarise(case: str | Path) -> dict:
     bubbles = bubbles[np.isfinite(bubbles)]
     return {
         "case": case.name,
+        "folder": str(case.resolve().relative_to(ROOT)) if case.resolve().is_relative_to(ROOT)
+        else str(case),
         "cells": metrics.get("cells"),
         "time_steps": metrics.get("time_steps"),
         "wall_s": metrics.get("wall_s"),

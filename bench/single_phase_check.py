@@ -7,6 +7,7 @@ island. Prints the pressure error on y = 0 outside the island per resolution lev
 ``bench/results/single_phase_check.{json,png}``.
 
     python bench/single_phase_check.py [--levels coarse medium fine] [--speed 0.008]
+        [--set KEY=VALUE ...] [--tag NAME]
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from ehl_precalc.rigid_reynolds import solve_rigid_reynolds  # noqa: E402
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
 from generator.gap_source import load_gap  # noqa: E402
+from common import spec_option  # noqa: E402
 from runs import case_fields  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
@@ -58,15 +60,22 @@ def main(argv=None) -> int:
     ap.add_argument("--levels", nargs="+", default=["coarse", "medium", "fine"])
     ap.add_argument("--speed", type=float, default=0.008)
     ap.add_argument("--work", default=str(ROOT / "runs" / "checks" / "single_phase"))
+    ap.add_argument("--set", action="append", default=[], type=spec_option, metavar="KEY=VALUE",
+                    help="any other spec option for every case (e.g. "
+                         "physics.interface_schemes=balanced)")
+    ap.add_argument("--tag", default="", help="results go to single_phase_check[_TAG].*; "
+                                              "cases to WORK[_TAG]/LEVEL")
     args = ap.parse_args(argv)
+    suffix = f"_{args.tag}" if args.tag else ""
     out = []
     lines = {}
     for level in args.levels:
         spec = make_case_spec({"name": f"single-phase-{level}", "scene": "single-phase",
                                "contact": {"speed": args.speed},
                                "mesh": {"resolution": level},
-                               "run": {"end_time": 3e-3, "writes_per_transit": 200}})
-        case = Path(args.work) / level
+                               "run": {"end_time": 3e-3, "writes_per_transit": 200}},
+                              **dict(args.set))
+        case = Path(args.work + suffix) / level
         t0 = time.perf_counter()
         geom = write_case(spec, case, overwrite=True)
         m = run_case(case)
@@ -81,7 +90,8 @@ def main(argv=None) -> int:
         outside = np.abs(x_cfd) > geom.island_radius + 0.5 * geom.a
         scale = np.max(np.abs(pr[ok]))
         err = np.abs(p_cfd - p_ref)[outside]
-        row = {"level": level, "cells": geom.cells, "n_layers": geom.n_layers,
+        row = {"level": level, "options": dict(args.set), "cells": geom.cells,
+               "n_layers": geom.n_layers,
                "p_ref_max_Pa": float(scale), "p_cfd_max_Pa": float(np.max(np.abs(p_cfd))),
                "max_error_over_pmax": float(err.max() / scale),
                "rms_error_over_pmax": float(np.sqrt(np.mean(err**2)) / scale),
@@ -90,12 +100,12 @@ def main(argv=None) -> int:
         out.append(row)
         lines[level] = (x_cfd, p_cfd)
     RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "single_phase_check.json").write_text(json.dumps(out, indent=2) + "\n")
-    _plot(lines, (xr, pr), geom)
+    (RESULTS / f"single_phase_check{suffix}.json").write_text(json.dumps(out, indent=2) + "\n")
+    _plot(lines, (xr, pr), geom, RESULTS / f"single_phase_check{suffix}.png")
     return 0
 
 
-def _plot(lines, ref, geom) -> None:
+def _plot(lines, ref, geom, path: Path) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -113,7 +123,7 @@ def _plot(lines, ref, geom) -> None:
     ax.legend(fontsize=8)
     ax.set_title("Single phase: pressure on y = 0, CFD vs Reynolds")
     fig.tight_layout()
-    fig.savefig(RESULTS / "single_phase_check.png", dpi=120)
+    fig.savefig(path, dpi=120)
 
 
 if __name__ == "__main__":

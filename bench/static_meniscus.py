@@ -9,7 +9,12 @@ nominal rolling speed. Writes ``bench/results/static_meniscus.json``.
     python bench/static_meniscus.py [--speed 0.008] [--time 0.02] [--levels coarse medium]
         [--compression 0 1] [--safety 1 0.25] [--air-viscosity 1.8e-5]
         [--nhat default pointCellsLeastSquares] [--set KEY=VALUE ...] [--tag NAME]
-        [--reanalyse]
+        [--edit FILE:KEY/SUBKEY=VALUE ...] [--solver interIsoFoam] [--reanalyse]
+
+``--edit`` changes an entry of a generated ``system/`` file in every case (e.g.
+``fvSchemes:snGradSchemes/default=uncorrected``); ``--solver interIsoFoam`` advects the oil
+with isoAdvector (geometric VoF) instead of MULES. Neither is a spec option: both are here to
+measure what the generator does not offer.
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from foamlib import FoamFieldFile, FoamFile  # noqa: E402
 
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
-from common import spec_option  # noqa: E402
+from common import apply_edits, foam_edit, spec_option  # noqa: E402
 from runs import case_fields  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
@@ -86,6 +91,12 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], type=spec_option, metavar="KEY=VALUE",
                     help="any other spec option for every case (e.g. mesh.polar_radius=6.8); "
                          "the cases go to folders with the options in their names")
+    ap.add_argument("--edit", action="append", default=[], type=foam_edit,
+                    metavar="FILE:KEY/SUBKEY=VALUE",
+                    help="change an entry of a system/ file in every case (e.g. "
+                         "fvSchemes:snGradSchemes/default=uncorrected)")
+    ap.add_argument("--solver", choices=["interFoam", "interIsoFoam"], default="interFoam",
+                    help="interIsoFoam: isoAdvector instead of MULES (cAlpha unused)")
     ap.add_argument("--tag", default="", help="results go to static_meniscus[_TAG].json")
     ap.add_argument("--reanalyse", action="store_true",
                     help="measure the cases already run in --work again instead of re-running")
@@ -102,7 +113,10 @@ def main(argv=None) -> int:
             "run": {"end_time": args.time, "capillary_safety": safety,
                     "writes_per_transit": 200}}, **dict(args.set))
         name = f"{level}_c{c_alpha:g}_s{safety:g}_air{mu_air:g}_t{args.time:g}" + "".join(
-            f"_{key.split('.')[-1]}{value}" for key, value in args.set)
+            f"_{key.split('.')[-1]}{value}" for key, value in args.set) + "".join(
+            f"_{keys[-1]}{''.join(map(str, value)) if isinstance(value, tuple) else value}"
+            for _, keys, value in args.edit) + ("" if args.solver == "interFoam" else
+                                                f"_{args.solver}")
         case = Path(args.work) / (name if nhat == "default" else f"{name}_{nhat.replace(' ', '')}")
         if args.reanalyse and (case / "metrics.json").exists():
             geom = load_geometry(case)
@@ -113,10 +127,14 @@ def main(argv=None) -> int:
                 with FoamFile(case / "system" / "fvSchemes") as f:
                     words = tuple(nhat.split())
                     f["gradSchemes"]["nHat"] = words if len(words) > 1 else nhat
+            apply_edits(case, args.edit, args.solver)
             m = run_case(case)
         s = spurious(case)
         row = {"level": level, "cAlpha": c_alpha, "capillary_safety": safety, "nHat": nhat,
-               "options": dict(args.set),
+               "options": dict(args.set), "solver": args.solver,
+               "edits": [f"{file}:{'/'.join(keys)}="
+                         f"{' '.join(value) if isinstance(value, tuple) else value}"
+                         for file, keys, value in args.edit],
                "air_viscosity": mu_air,
                "air_viscosity_in_solver": mu_air * spec.run.air_viscosity_factor,
                "max_delta_t_s": geom.max_delta_t, "cells": geom.cells,
