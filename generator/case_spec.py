@@ -114,6 +114,13 @@ class Physics(BaseModel):
             taken from the local speed |U| instead of the flux through each face (0, the
             default: all from the face flux, so a meniscus lying along the flow is hardly
             compressed; 1: every face of it as hard).
+        interface_schemes: "standard" (the default: the templates' schemes) or "balanced":
+            uncorrected face gradients for pressure and surface tension alike (on the thin-gap
+            mesh's up to ~23 degree non-orthogonal faces the corrected ones do not balance a
+            resting meniscus exactly), the interface normal from a point-cells least-squares
+            gradient, and the compression flux limited to the interface
+            (``Gauss interfaceCompression``). 3-10x smaller spurious currents at a static
+            meniscus with the default compression (docs/cases.md).
         ambient_pressure: [Pa, absolute] at the open boundaries (cavitating scene; the
             interface scene works in gauge pressure and adds it only to report one).
         cavitation_pressure: [Pa, absolute] the pressure floor of the cavitating scene
@@ -151,6 +158,7 @@ class Physics(BaseModel):
     viscosity_factor: float = Field(1.0, gt=0.0, le=1e3)
     interface_compression: float = Field(1.0, ge=0.0, le=4.0)
     isotropic_compression: float = Field(0.0, ge=0.0, le=1.0)
+    interface_schemes: Literal["standard", "balanced"] = "standard"
     ambient_pressure: float = Field(1.013e5, gt=1e3, le=1e7)
     cavitation_pressure: float = Field(1e3, gt=0.0, le=1e5)
     oil_bulk_modulus: float | None = Field(None, gt=1e6, le=1e11)

@@ -328,9 +328,24 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
         f["solvers"]['"alpha.oil.*"']["cAlpha"] = spec.physics.interface_compression
         f["solvers"]['"alpha.oil.*"']["icAlpha"] = spec.physics.isotropic_compression
         f["PIMPLE"]["nCorrectors"] = spec.run.pressure_correctors
+    if spec.physics.interface_schemes == "balanced":
+        _balance_interface_schemes(case)
     with FoamFile(case / "system" / "decomposeParDict") as f:
         f["numberOfSubdomains"] = spec.run.n_procs
         f["coeffs"]["n"] = [spec.run.n_procs, 1, 1]
+
+
+def _balance_interface_schemes(case: Path) -> None:
+    """``physics.interface_schemes = "balanced"``: the pressure and the surface tension take
+    their face gradients the same, uncorrected way (so that a resting meniscus can be in
+    exact discrete balance on non-orthogonal faces), the interface normal comes from a
+    smoother point-cells least-squares gradient, and the compression flux is limited to the
+    interface."""
+    with FoamFile(case / "system" / "fvSchemes") as f:
+        f["snGradSchemes"]["default"] = "uncorrected"
+        f["laplacianSchemes"]["default"] = ("Gauss", "linear", "uncorrected")
+        f["gradSchemes"]["nHat"] = "pointCellsLeastSquares"
+        f["divSchemes"]["div(phirb,alpha)"] = ("Gauss", "interfaceCompression")
 
 
 def _edit_transport(spec: CaseSpec, case: Path) -> None:

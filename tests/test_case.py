@@ -314,6 +314,32 @@ def test_polar_ring_case_builds_and_runs(tmp_path):
     assert m["oil_mass_balance_error"] < 0.1
 
 
+@pytest.mark.parametrize("scene", ["interface", "cavitating", "gas-release"])
+def test_balanced_interface_schemes_reach_every_solver(tmp_path, scene):
+    """physics.interface_schemes = "balanced" writes uncorrected face gradients, the
+    least-squares interface normal and the limited compression flux, and interFoam,
+    compressibleInterFoam and interPhaseChangeFoam all run with them; "standard" keeps the
+    templates' schemes."""
+    spec = make_case_spec({**SMALL, "scene": scene,
+                           "run": {**SMALL["run"], "end_time": 2e-4}},
+                          **{"physics.interface_schemes": "balanced"})
+    case = tmp_path / scene
+    write_case(spec, case)
+    with FoamFile(case / "system" / "fvSchemes") as f:
+        assert f["snGradSchemes"]["default"] == "uncorrected"
+        assert tuple(f["laplacianSchemes"]["default"]) == ("Gauss", "linear", "uncorrected")
+        assert f["gradSchemes"]["nHat"] == "pointCellsLeastSquares"
+        assert tuple(f["divSchemes"]["div(phirb,alpha)"]) == ("Gauss", "interfaceCompression")
+    m = run_case(case, wall_limit=120)
+    assert m["status"] == "finished" and m["end_reason"] == "end_time", m
+    assert m["time_steps"] > 3
+    standard = tmp_path / f"{scene}-standard"
+    write_case(make_case_spec({**SMALL, "scene": scene}), standard)
+    with FoamFile(standard / "system" / "fvSchemes") as f:
+        assert tuple(f["snGradSchemes"]["default"].split()) == ("corrected",)
+        assert "nHat" not in f["gradSchemes"]
+
+
 def test_cavitating_case_runs_a_few_steps(tmp_path):
     """The cavitating scene (compressibleInterFoam, air a perfect gas, absolute pressure):
     builds, runs, and reports the bubble and the lowest pressure."""
@@ -591,6 +617,44 @@ def test_static_meniscus_stays_put(tmp_path):
     assert u_oil < 0.2 * spec.speed, f"spurious velocity in the oil {u_oil:.3g} m/s"
     # within a third of the test mesh's cells there (~0.6 a; 0.03 a at the coarse level)
     assert m["inlet_meniscus_distance_over_a"] == pytest.approx(2.0, abs=0.2)
+    assert m["oil_volume_m3"] == pytest.approx(m["oil_volume_initial_m3"], rel=1e-3)
+
+
+def test_static_meniscus_on_the_polar_ring_moves_less_than_1_percent_of_u(tmp_path):
+    """Where the issue's 1 % holds: the coarse level with a polar ring of cells around the
+    contact (mesh.polar_radius) and weak interface compression (cAlpha 0.25), not the
+    defaults. What moves a meniscus in a thin gap is the gap-averaged oil velocity; at every
+    write of the second half of 30 ms its largest value stays below 1 % of u (measured on
+    this case: 0.66 % at most, 0.43 % at the last write; with cAlpha 1 the same mesh reaches
+    2-7 %, docs/cases.md, "A polar ring around the contact")."""
+    speed = 0.008
+    spec = make_case_spec({
+        "name": "static-ring", "walls_moving": False,
+        "contact": {"speed": speed, "grid": SMALL["contact"]["grid"],
+                    "tol_residual": SMALL["contact"]["tol_residual"]},
+        "mesh": {"resolution": "coarse", "polar_radius": 6.8},
+        "supply": {"mode": "layers", "disc_layer": 0.0, "ball_layer": 0.0,
+                   "initial_puddle": 3.0},
+        "physics": {"interface_compression": 0.25},
+        "run": {"end_time": 0.03, "capillary_safety": 1.0, "writes_per_transit": 200}})
+    case = tmp_path / "static-ring"
+    write_case(spec, case)
+    m = run_case(case, wall_limit=600)
+    assert m["status"] == "finished", m
+    st = case_fields.Structure.load(case)
+    times = case_fields.time_folders(case)
+    end = float(times[-1][0])
+
+    def column_speeds(folder: Path) -> np.ndarray:
+        """Gap-averaged in-plane speed of the columns that are oil from wall to wall."""
+        U = np.asarray(FoamFieldFile(folder / "U").internal_field, float)
+        alpha = np.asarray(FoamFieldFile(folder / "alpha.oil").internal_field, float)
+        oil_column = st.gap_mean(alpha <= 0.99) == 0.0
+        return np.linalg.norm(st.gap_mean(U[:, :2]), axis=1)[oil_column]
+
+    late = max(column_speeds(folder).max() for t, folder in times if float(t) >= 0.5 * end)
+    assert late < 0.01 * speed, f"gap-averaged oil speed {late:.3g} m/s"
+    assert m["inlet_meniscus_distance_over_a"] == pytest.approx(2.0, abs=0.1)
     assert m["oil_volume_m3"] == pytest.approx(m["oil_volume_initial_m3"], rel=1e-3)
 
 
