@@ -340,7 +340,8 @@ def _balance_interface_schemes(case: Path) -> None:
     their face gradients the same, uncorrected way (so that a resting meniscus can be in
     exact discrete balance on non-orthogonal faces), the interface normal comes from a
     smoother point-cells least-squares gradient, and the compression flux is limited to the
-    interface."""
+    interface. Calmer at rest, but the uncorrected gradients are an error on non-orthogonal
+    faces in a rolling case (docs/cases.md)."""
     with FoamFile(case / "system" / "fvSchemes") as f:
         f["snGradSchemes"]["default"] = "uncorrected"
         f["laplacianSchemes"]["default"] = ("Gauss", "linear", "uncorrected")
