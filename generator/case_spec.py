@@ -120,7 +120,7 @@ class Physics(BaseModel):
             resting meniscus exactly), the interface normal from a point-cells least-squares
             gradient, and the compression flux limited to the interface
             (``Gauss interfaceCompression``). At a static meniscus with the default
-            compression it cuts the currents 7-11x on the polar ring (to 0.6-1 % of u); in a
+            compression it cuts the currents 7-20x on the polar ring (to 0.6-1 % of u); in a
             rolling case it moves the flooded region (inlet meniscus 12 % upstream, 16-37 %
             more oil) where fully corrected gradients keep the standard answer, hence not
             the default (docs/cases.md, "Balanced interface schemes").
