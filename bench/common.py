@@ -119,8 +119,10 @@ def apply_edits(case: Path, edits: list, solver: str = "") -> None:
             for key in keys[:-1]:
                 entry = entry[key]
             entry[keys[-1]] = value
+    if not solver:
+        return
     geom = load_geometry(case)
-    if solver and solver != geom.solver:
+    if solver != geom.solver:
         with FoamFile(case / "system" / "controlDict") as f:
             f["application"] = solver
         geom = dataclasses.replace(geom, solver=solver)

@@ -30,7 +30,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from foamlib import FoamFieldFile, FoamFile  # noqa: E402
+from foamlib import FoamFieldFile  # noqa: E402
 
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
@@ -48,8 +48,7 @@ def _speeds(folder: Path, st: case_fields.Structure) -> dict:
     a = np.asarray(FoamFieldFile(folder / "alpha.oil").internal_field, float)
     oil, air = a > 0.99, a < 0.01
     band = ~oil & ~air
-    oil_col = st.gap_mean(~oil) == 0.0  # columns that are oil from wall to wall
-    u_col = np.linalg.norm(st.gap_mean(U[:, :2]), axis=1)[oil_col]
+    u_col = st.oil_column_speeds(U, a)
     return {"u_oil_max": float(speed[oil].max()),
             "u_oil_p99": float(np.percentile(speed[oil], 99)),
             "u_interface_max": float(speed[band].max()) if band.any() else 0.0,
@@ -123,11 +122,9 @@ def main(argv=None) -> int:
             m = json.loads((case / "metrics.json").read_text())
         else:
             geom = write_case(spec, case, overwrite=True)
-            if nhat != "default":
-                with FoamFile(case / "system" / "fvSchemes") as f:
-                    words = tuple(nhat.split())
-                    f["gradSchemes"]["nHat"] = words if len(words) > 1 else nhat
-            apply_edits(case, args.edit, args.solver)
+            nhat_edit = [] if nhat == "default" else [
+                foam_edit(f"fvSchemes:gradSchemes/nHat={nhat}")]
+            apply_edits(case, nhat_edit + args.edit, args.solver)
             m = run_case(case)
         s = spurious(case)
         row = {"level": level, "cAlpha": c_alpha, "capillary_safety": safety, "nHat": nhat,

@@ -59,6 +59,13 @@ class Structure:
         return np.stack([np.bincount(self.base_cell, f[:, k] * w, minlength=n_base)
                          for k in range(f.shape[1])], axis=1) / col[:, None]
 
+    def oil_column_speeds(self, U: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+        """Gap-averaged in-plane speed [m/s] of each column of cells that is oil
+        (alpha > 0.99) from wall to wall: the net in-plane flow that can move a meniscus in
+        a thin gap, without the recirculation across it (the static-meniscus measure)."""
+        oil_column = self.gap_mean(np.asarray(alpha) <= 0.99) == 0.0
+        return np.linalg.norm(self.gap_mean(np.asarray(U)[:, :2]), axis=1)[oil_column]
+
     def mid_gap(self, field: np.ndarray, n_layers: int) -> np.ndarray:
         """Per base cell, the value at mid-gap (the middle layer, or the mean of the two
         middle layers for an even count)."""

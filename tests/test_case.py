@@ -646,11 +646,9 @@ def test_static_meniscus_on_the_polar_ring_moves_less_than_1_percent_of_u(tmp_pa
     end = float(times[-1][0])
 
     def column_speeds(folder: Path) -> np.ndarray:
-        """Gap-averaged in-plane speed of the columns that are oil from wall to wall."""
         U = np.asarray(FoamFieldFile(folder / "U").internal_field, float)
         alpha = np.asarray(FoamFieldFile(folder / "alpha.oil").internal_field, float)
-        oil_column = st.gap_mean(alpha <= 0.99) == 0.0
-        return np.linalg.norm(st.gap_mean(U[:, :2]), axis=1)[oil_column]
+        return st.oil_column_speeds(U, alpha)
 
     late = max(column_speeds(folder).max() for t, folder in times if float(t) >= 0.5 * end)
     assert late < 0.01 * speed, f"gap-averaged oil speed {late:.3g} m/s"
