@@ -86,8 +86,9 @@ def spec_option(text: str) -> tuple[str, Any]:
 
 
 def foam_edit(text: str) -> tuple[str, tuple[str, ...], object]:
-    """``FILE:KEY/SUBKEY=VALUE`` of a ``system/`` file entry; VALUE is a word, a number or
-    several words (a scheme); an argparse ``type``."""
+    """``FILE:KEY/SUBKEY=VALUE`` of a ``system/`` file entry (or, where FILE has a folder,
+    of that case file: ``0.orig/alpha.oil:boundaryField/"(disc|ball|island)"/limit=none``);
+    VALUE is a word, a number or several words (a scheme); an argparse ``type``."""
     target, sep, value = text.partition("=")
     file, colon, path = target.partition(":")
     if not sep or not colon or not path:
@@ -114,7 +115,7 @@ def apply_edits(case: Path, edits: list, solver: str = "") -> None:
     from generator.case_writer import META, load_geometry
 
     for file, keys, value in edits:
-        with FoamFile(case / "system" / file) as f:
+        with FoamFile(case / file if "/" in file else case / "system" / file) as f:
             entry = f
             for key in keys[:-1]:
                 entry = entry[key]

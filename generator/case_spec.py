@@ -42,7 +42,7 @@ import math
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ehl_precalc.spec import PrecalcSpec, SpecError, range_text, read_toml
 
@@ -58,6 +58,10 @@ RESOLUTIONS: dict[str, dict[str, float]] = {
     "medium": {"size_rim": 0.08, "size_far": 0.55, "n_layers": 12, "wall_grading": 10.0},
     "fine": {"size_rim": 0.055, "size_far": 0.38, "n_layers": 14, "wall_grading": 12.0},
 }
+
+#: mesh.polar_radius = "auto": the polar ring's outer radius over the nearest boundary's
+#: distance (6.8 a in the default 8 a wide half domain, the radius measured on every level).
+POLAR_RING_SHARE = 0.85
 
 
 class Supply(BaseModel):
@@ -211,9 +215,11 @@ class Mesh(BaseModel):
             cells at the walls carry the supply layers and the films left behind.
         polar_radius: outer radius, units of a, of a structured polar ring of cells around
             the island (log-polar, near-square cells, the size growing with the radius as
-            everywhere); None: free quads everywhere. Below 0.95 x the nearest boundary.
-            A circular meniscus meets every ring cell the same way (docs/cases.md, "A polar
-            ring around the contact").
+            everywhere); "auto" (the default): :data:`POLAR_RING_SHARE` x the nearest
+            boundary (6.8 a in the default domain); None: free quads everywhere. Below
+            0.95 x the nearest boundary. A circular meniscus meets every ring cell the same
+            way, which converges the flooded width where free quads do not (docs/cases.md,
+            "A polar ring around the contact", "The polar ring becomes the default").
     """
 
     model_config = _STRICT
@@ -222,7 +228,19 @@ class Mesh(BaseModel):
     size_rim: float | None = Field(None, gt=0.0, le=10.0)
     size_far: float | None = Field(None, gt=0.0, le=50.0)
     wall_grading: float | None = Field(None, ge=1.0, le=100.0)
-    polar_radius: float | None = Field(None, gt=1.0, le=200.0)
+    polar_radius: float | Literal["auto"] | None = "auto"
+
+    @field_validator("polar_radius", mode="before")
+    @classmethod
+    def _polar_radius_valid(cls, value: Any) -> Any:
+        if value is None or value == "auto":
+            return value
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not 1.0 < value <= 200.0:
+            raise ValueError('must be a radius in units of a (1 < radius <= 200), "auto" '
+                             f'({POLAR_RING_SHARE:g} x the nearest boundary) or none (free '
+                             'quads)')
+        return float(value)
 
     def level(self) -> dict[str, float]:
         """The level's sizes with the overrides applied."""
@@ -317,8 +335,8 @@ class CaseSpec(BaseModel):
 
     @model_validator(mode="after")
     def _polar_ring_inside(self) -> "CaseSpec":
-        rp, d = self.mesh.polar_radius, self.domain
-        if rp is not None:
+        rp, d = self.polar_radius, self.domain
+        if rp is not None and self.mesh.polar_radius != "auto":
             top = 0.95 * min(d.upstream, d.downstream, d.side)
             if not d.island_radius < rp <= top:
                 raise ValueError(f"mesh.polar_radius = {rp:g} a must lie in "
@@ -332,6 +350,15 @@ class CaseSpec(BaseModel):
     def a(self) -> float:
         """Hertzian radius [m]."""
         return self.contact.contact().a
+
+    @property
+    def polar_radius(self) -> float | None:
+        """Outer radius of the polar ring, units of a (``mesh.polar_radius`` with "auto"
+        resolved against the domain), or None for free quads."""
+        rp, d = self.mesh.polar_radius, self.domain
+        if rp == "auto":
+            return POLAR_RING_SHARE * min(d.upstream, d.downstream, d.side)
+        return rp
 
     @property
     def speed(self) -> float:

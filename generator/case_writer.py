@@ -470,8 +470,8 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
     params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
                         island_radius=d.island_radius * a, n_layers=level["n_layers"],
                         symmetric=d.symmetry == "half",
-                        polar_radius=None if spec.mesh.polar_radius is None
-                        else spec.mesh.polar_radius * a)
+                        polar_radius=None if spec.polar_radius is None
+                        else spec.polar_radius * a)
     base = build_base_mesh(params, size_function(spec))
     mesh = extrude(base, gap, level["n_layers"], level["wall_grading"])
     steps = float(np.median(wall_steps(base, mesh)))

@@ -51,6 +51,7 @@ def _copy(case: Path, tmp_path: Path) -> Path:
     ("[mesh]\nresolution = \"ultra\"\n", "mesh.resolution = 'ultra'", "'coarse', 'medium' or 'fine'"),
     ("[domain]\nisland_radius = 9.0\n", "island_radius = 9 a", "nearest boundary"),
     ("[mesh]\npolar_radius = 7.9\n", "mesh.polar_radius = 7.9 a", "(1.5, 7.6] a"),
+    ("[mesh]\npolar_radius = \"ring\"\n", "mesh.polar_radius = 'ring'", '"auto"'),
     ("[contact]\ntemperature = 99.0\n", "temperature = 99 C", "valid range 25 to 60 C"),
     ("[run]\nsteady_tolerance = 2.0\n", "run.steady_tolerance = 2.0", "steady_tolerance < 1"),
     ("scene = \"gas-release\"\n[physics]\ngas_release_rate = 0.0\n",
@@ -85,6 +86,16 @@ def test_set_none_clears_an_optional_key_and_is_refused_for_a_required_one(tmp_p
                            "--set", "contact.speed=none"], capture_output=True, text=True)
     assert proc.returncode == 2 and "contact.speed" in proc.stderr, proc.stderr
     assert not out.exists()
+
+
+def test_polar_ring_is_the_default_and_auto_follows_the_domain():
+    """mesh.polar_radius = "auto" (the default) is 0.85 x the nearest boundary: 6.8 a in the
+    default domain, 0.85 x 5 a when the side comes in to 5 a; none gives free quads."""
+    assert make_case_spec().mesh.polar_radius == "auto"
+    assert make_case_spec().polar_radius == pytest.approx(6.8)
+    assert make_case_spec(**{"domain.side": 5.0}).polar_radius == pytest.approx(4.25)
+    assert make_case_spec(**{"mesh.polar_radius": 5.5}).polar_radius == 5.5
+    assert make_case_spec(**{"mesh.polar_radius": parse_value("none")}).polar_radius is None
 
 
 def test_spec_defaults_are_the_reference_case():
