@@ -73,6 +73,17 @@ def test_not_steady_in_the_mean_while_the_mean_moves(change):
     assert steady_test(h, window=0.1, tol=0.01, length_scale=10.0) is None
 
 
+def test_not_steady_while_the_oil_starts_rising_again():
+    """Flat for two transits, then the oil rises 1.5 % a transit (0.15 % a write) over the
+    last one: the window means are 0.8 % apart and the last write's partner a transit back
+    is 1.5 % below, so without the trend a 1 % test in the mean passes; with it, none."""
+    h = fluctuating(32)
+    for k, s in enumerate(h[21:], start=1):
+        s.oil_volume = 1.0 + 0.0015 * k
+    assert steady_test(h, window=0.1, tol=0.01, length_scale=10.0) is None
+    assert steady_test(h, window=0.1, tol=0.02, length_scale=10.0) == "window mean"
+
+
 def test_mass_balance_closes_for_a_consistent_history():
     # volume grows at q_in - q_out = 2 - 1 = 1 per second
     h = [Sample(time=t, oil_volume=5.0 + t, oil_in=2.0, oil_out=1.0, pattern={})
