@@ -152,9 +152,9 @@ def test_time_step_options_reach_the_dictionaries(tmp_path):
     dx = geom.min_cell_size
     assert geom.max_delta_t == pytest.approx(min(capillary_time_step(spec, dx),
                                                  geom.write_interval))
-    default = make_case_spec(SMALL)           # capillary_safety 3 (the default)
+    default = make_case_spec(SMALL)           # capillary_safety 2 (the default)
     assert capillary_time_step(spec, dx) == pytest.approx(
-        capillary_time_step(default, dx) * 1.5 / 3.0, rel=1e-12)
+        capillary_time_step(default, dx) * 1.5 / default.run.capillary_safety, rel=1e-12)
 
 
 @pytest.mark.parametrize("level, ring", [("coarse", False), ("medium", False), ("medium", True)])
