@@ -271,7 +271,7 @@ class Run(BaseModel):
             (viscous, the one that matters at Re << 1), "brackbill" (inertial, strict) or
             "none".
         capillary_safety: factor on that limit. 2 (the default since 2026-11-24): a
-            meniscus at rest keeps its currents at 7-8 % of u where 3 let them burst to
+            meniscus at rest keeps its currents at 7.5-8.5 % of u where 3 let them burst to
             42 %, and the rolling case's oil and length move halfway to the values of 1, at
             1.5 times the steps a transit of 3 (1: 3.4 times). docs/cases.md, "The capillary
             safety".
