@@ -338,8 +338,8 @@ class CaseSpec(BaseModel):
 
     @model_validator(mode="after")
     def _polar_ring_inside(self) -> "CaseSpec":
-        rp, d = self.polar_radius, self.domain
-        if rp is not None and self.mesh.polar_radius != "auto":
+        rp, d = self.polar_radius, self.domain   # "auto" resolved: always inside
+        if rp is not None:
             top = 0.95 * min(d.upstream, d.downstream, d.side)
             if not d.island_radius < rp <= top:
                 raise ValueError(f"mesh.polar_radius = {rp:g} a must lie in "
