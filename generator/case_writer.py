@@ -193,11 +193,13 @@ def supply_fraction(spec: CaseSpec, mesh: PolyMesh, patch: str = "inlet") -> np.
     # a face is a vertical trapezoid: its bottom and top are the means of its two lower and
     # two upper corners, so that the supplied area is exact
     z = np.sort(mesh.points[faces, 2], axis=1)
-    y = mesh.points[faces, 1].mean(axis=1)
     z_lo, z_hi = z[:, :2].mean(axis=1), z[:, 2:].mean(axis=1)
-    # the column height at each face: the highest point of the faces at the same y
-    key = np.round(y, 12)
-    _, inverse = np.unique(key, return_inverse=True)
+    # the column height at each face: the highest point of the faces above the same 2D
+    # edge (point p is a level of 2D node p // (n_layers + 1); columns may lean, so their
+    # nodes need not share a y)
+    nodes = np.sort(faces // (int(mesh.layer.max()) + 2), axis=1)
+    _, inverse = np.unique(nodes[:, [0, -1]], axis=0, return_inverse=True)
+    inverse = inverse.ravel()
     column = np.zeros(inverse.max() + 1)
     np.maximum.at(column, inverse, z_hi)
     # the part of each face's width on the track (less its dry middle band, if any), so that

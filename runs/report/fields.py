@@ -14,7 +14,6 @@ an absolute pressure (cavitating scene) is turned into gauge here.
 from __future__ import annotations
 
 import functools
-import math
 import os
 import tempfile
 from dataclasses import dataclass
@@ -144,14 +143,3 @@ def load_fields(case: str | os.PathLike, geom: CaseGeometry, scene: str = "inter
     offset = ambient_pressure if scene == "cavitating" else 0.0
     return Fields(time=t, folder=folder, mesh=mesh, structure=structure, geom=geom,
                   gauge_offset=offset)
-
-
-def gap_profile(sl_x: np.ndarray, sl_z: np.ndarray,
-                decimals: int = 9) -> tuple[np.ndarray, np.ndarray]:
-    """(x, h) of a slice's points: the largest z at each distinct x [m] (the ball surface
-    along the cut), sorted by x."""
-    key = np.round(sl_x, decimals)
-    xs, inverse = np.unique(key, return_inverse=True)
-    h = np.full(len(xs), -math.inf)
-    np.maximum.at(h, inverse, sl_z)
-    return xs, h

@@ -15,8 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ehl_precalc.gap import GapField
+
 from . import style
-from .fields import Fields, gap_profile
+from .fields import Fields
 
 #: Longest velocity arrow, in units of the rolling speed u.
 MAX_ARROW = 1.5
@@ -57,7 +59,10 @@ def cut_at_axis(fields: Fields) -> Cut:
     alpha = np.asarray(sl.cell_data["alpha.oil"], float)
     u = np.asarray(sl.cell_data["U"], float) if "U" in sl.cell_data else \
         np.zeros((len(tri), 3))
-    px, ph = gap_profile(pts[:, 0], pts[:, 2])
+    # the ball along the cut, from the case's own gap export: the cut's highest points need
+    # not lie on the ball where the node columns lean (generator/mesh.py, "normal")
+    px = np.unique(pts[:, 0])
+    ph = GapField.load(fields.folder.parent / "precalc")(px, np.full_like(px, y_c))
     return Cut(x=pts[:, 0], z=pts[:, 2], triangles=tri, alpha=np.clip(alpha, 0, 1),
                ux=u[:, 0], uz=u[:, 2], profile_x=px, profile_h=ph)
 
