@@ -220,6 +220,10 @@ class Mesh(BaseModel):
             0.95 x the nearest boundary. A circular meniscus meets every ring cell the same
             way, which converges the flooded width where free quads do not (docs/cases.md,
             "A polar ring around the contact", "The polar ring becomes the default").
+        columns: how the columns of nodes cross the gap: "normal" (the default) leans each
+            column so that it meets every layer at right angles (an in-plane shift of a
+            few um at most), "vertical" keeps them upright, which makes every face where
+            the ball slopes non-orthogonal (docs/cases.md, "Columns across the gap").
     """
 
     model_config = _STRICT
@@ -229,6 +233,7 @@ class Mesh(BaseModel):
     size_far: float | None = Field(None, gt=0.0, le=50.0)
     wall_grading: float | None = Field(None, ge=1.0, le=100.0)
     polar_radius: float | Literal["auto"] | None = "auto"
+    columns: Literal["normal", "vertical"] = "normal"
 
     @field_validator("polar_radius", mode="before")
     @classmethod

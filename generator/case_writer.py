@@ -475,7 +475,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
                         polar_radius=None if spec.polar_radius is None
                         else spec.polar_radius * a)
     base = build_base_mesh(params, size_function(spec))
-    mesh = extrude(base, gap, level["n_layers"], level["wall_grading"])
+    mesh = extrude(base, gap, level["n_layers"], level["wall_grading"], spec.mesh.columns)
     steps = float(np.median(wall_steps(base, mesh)))
     mesh, supply = with_supply_patch(spec, mesh)
     dx = level["size_rim"] * a

@@ -506,12 +506,68 @@ def test_wall_steps_count_the_ball_stair_steps():
     h_mean = h0 + g * d / 2
 
     def steps(gap, n_layers, grading=1.0):
-        return wall_steps(base, extrude(base, gap, n_layers, grading))[0]
+        return wall_steps(base, extrude(base, gap, n_layers, grading, columns="vertical"))[0]
 
     assert steps(gap, 4) == pytest.approx(g * d / (0.25 * h_mean))
     wall = np.diff(layer_fractions(10, 8.0))[0]
     assert steps(gap, 10, 8.0) / steps(gap, 10) == pytest.approx(0.1 / wall)
     assert steps(lambda x, y: h0 + 0 * x, 4) == 0.0                    # a flat ball: none
+
+
+def _face_tilt_mismatch(mesh: PolyMesh) -> tuple[np.ndarray, np.ndarray]:
+    """Per internal face, degrees: the non-orthogonality of the level faces (normal mostly
+    along z) and, for the lateral faces, the difference between the elevation of the
+    owner-to-neighbour vector and that of the face normal (the part of their
+    non-orthogonality that the columns, not the 2D mesh, make)."""
+    n = mesh.n_internal_faces
+    d = mesh.cell_centres[mesh.neighbour] - mesh.cell_centres[mesh.owner[:n]]
+    s = mesh.face_areas[:n]
+    dn, sn = np.linalg.norm(d, axis=1), np.linalg.norm(s, axis=1)
+    level = np.abs(s[:, 2]) > 0.5 * sn
+    angle = np.degrees(np.arccos(np.clip(np.sum(d * s, axis=1) / (dn * sn), -1, 1)))
+    elevation = np.degrees(np.abs(np.arcsin(d[:, 2] / dn) - np.arcsin(s[:, 2] / sn)))
+    return angle[level], elevation[~level]
+
+
+def test_normal_columns_meet_the_levels_at_right_angles(coarse_base: BaseMesh) -> None:
+    """Vertical columns tilt every face where the ball slopes; columns along the levels'
+    normals do not, and they keep the boundaries where they were and the gap as it was."""
+    vertical = extrude(coarse_base, hertz_gap, N_LAYERS, columns="vertical")
+    normal = extrude(coarse_base, hertz_gap, N_LAYERS)              # the default
+    lv, ev = _face_tilt_mismatch(vertical)
+    ln, en = _face_tilt_mismatch(normal)
+    assert lv.mean() > 1.0 and ev.mean() > 0.5                     # what the slope makes
+    assert ln.mean() < 0.1 * lv.mean() and en.mean() < 0.1 * ev.mean()
+    assert np.percentile(en, 99) < 0.1 * np.percentile(ev, 99)
+    # the same cells, the same volume, the ball still on the gap
+    assert normal.n_cells == vertical.n_cells
+    assert normal.cell_volumes.min() > 0
+    assert normal.cell_volumes.sum() == pytest.approx(vertical.cell_volumes.sum(), rel=1e-3)
+    assert gap_mismatch(normal, hertz_gap) < 0.01
+    # the disc's nodes and every boundary stay put: planes planar, the island a cylinder
+    p = params()
+    cols = normal.points.reshape(coarse_base.n_points, N_LAYERS + 1, 3)
+    assert np.array_equal(cols[:, 0, :2], coarse_base.points)
+    assert np.all(cols[:, 0, 2] == 0.0)
+    on = {name: np.unique(e) for name, e in coarse_base.edges.items()}
+    assert np.all(cols[on["inlet"], :, 0] == p.x_min)
+    assert np.all(cols[on["outlet"], :, 0] == p.x_max)
+    assert np.all(cols[on["side"], :, 1] == p.y_max)
+    assert np.all(cols[on["symmetry"], :, 1] == 0.0)
+    r = np.hypot(cols[on["island"], :, 0], cols[on["island"], :, 1])
+    assert r == pytest.approx(np.full_like(r, p.island_radius), rel=1e-12)
+    # the lean (h |grad h| / 2 at the ball) is a fraction of the node's shortest edge
+    shift = np.linalg.norm(cols[:, -1, :2] - coarse_base.points, axis=1)
+    quads = coarse_base.quads
+    edge = np.linalg.norm(coarse_base.points[np.roll(quads, -1, axis=1)]
+                          - coarse_base.points[quads], axis=2)
+    shortest = np.full(coarse_base.n_points, np.inf)
+    for k in range(4):
+        np.minimum.at(shortest, quads[:, k], edge[:, k])
+        np.minimum.at(shortest, np.roll(quads, -1, axis=1)[:, k], edge[:, k])
+    assert 0 < np.max(shift / shortest) < 0.25
+    with pytest.raises(ValueError, match="columns must be one of"):
+        extrude(coarse_base, hertz_gap, N_LAYERS, columns="slanted")
 
 
 def test_split_patch_keeps_a_valid_mesh():
