@@ -7,7 +7,8 @@ its centre (exact for a prism column, and the columns here are prisms to within 
 the ball). A value is carried over in two steps:
 
 1. across the gap: in every source column, linear in zeta onto the target's layer heights
-   (the mean zeta of each target layer; the grading is the same in every column);
+   (the mean zeta of each target layer; the grading is the same in every column, to 4e-4
+   in zeta where the columns lean along the levels' normals, ``mesh.columns = "normal"``);
 2. in plane: linear over a Delaunay triangulation of the source column centres, nearest column
    outside their hull.
 

@@ -12,15 +12,23 @@ from runs.field_mapping import LayeredMesh, interpolate
 from tiny import SMALL
 
 
-@pytest.fixture(scope="module")
-def meshes(tmp_path_factory):
-    """The tiny case's mesh (3 layers) and a finer one (smaller cells, 5 layers)."""
-    root = tmp_path_factory.mktemp("mapping")
+#: How exactly a linear field is carried over, by the meshes' columns: exact where the
+#: columns stand upright (every column graded alike); where they lean along the levels'
+#: normals (the default) a layer's relative height varies by 4e-4 from column to column,
+#: which moved the field below by 6.4e-4 at most (measured 2026-11-24).
+LINEAR_TOLERANCE = {"vertical": 1e-9, "normal": 2e-3}
+
+
+@pytest.fixture(scope="module", params=sorted(LINEAR_TOLERANCE))
+def meshes(request, tmp_path_factory):
+    """The tiny case's mesh (3 layers) and a finer one (smaller cells, 5 layers), with the
+    node columns of ``request.param``."""
+    root = tmp_path_factory.mktemp(f"mapping_{request.param}")
     coarse, fine = root / "coarse", root / "fine"
-    write_case(make_case_spec(SMALL), coarse)
-    write_case(make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "size_rim": 0.18,
-                                                 "n_layers": 5}}), fine)
-    return coarse, fine
+    mesh = {**SMALL["mesh"], "columns": request.param}
+    write_case(make_case_spec({**SMALL, "mesh": mesh}), coarse)
+    write_case(make_case_spec({**SMALL, "mesh": {**mesh, "size_rim": 0.18, "n_layers": 5}}), fine)
+    return coarse, fine, LINEAR_TOLERANCE[request.param]
 
 
 def test_relative_heights_span_the_gap(meshes):
@@ -34,7 +42,8 @@ def test_relative_heights_span_the_gap(meshes):
 
 
 def test_a_linear_field_is_carried_over_exactly_inside_the_source(meshes):
-    src, dst = (LayeredMesh.load(c) for c in meshes)
+    src, dst = (LayeredMesh.load(c) for c in meshes[:2])
+    tolerance = meshes[2]
     a = load_geometry(meshes[0]).a
 
     def field(m: LayeredMesh) -> np.ndarray:
@@ -50,16 +59,16 @@ def test_a_linear_field_is_carried_over_exactly_inside_the_source(meshes):
     in_hull = Delaunay(src.base_xy).find_simplex(dst.base_xy[dst.base_cell]) >= 0
     interior = inner & in_hull
     assert interior.sum() > 0.5 * len(dst.zeta)
-    np.testing.assert_allclose(got[interior], want[interior], atol=1e-9)
+    np.testing.assert_allclose(got[interior], want[interior], atol=tolerance)
     # vectors: component by component
     vec = np.stack([field(src), 2 * field(src), np.zeros(len(src.zeta))], axis=1)
     got_vec = interpolate(vec, src, dst)
     assert got_vec.shape == (len(dst.zeta), 3)
-    np.testing.assert_allclose(got_vec[interior, 1], 2 * want[interior], atol=1e-9)
+    np.testing.assert_allclose(got_vec[interior, 1], 2 * want[interior], atol=2 * tolerance)
 
 
 def test_values_stay_within_the_source_range(meshes):
-    src, dst = (LayeredMesh.load(c) for c in meshes)
+    src, dst = (LayeredMesh.load(c) for c in meshes[:2])
     rng = np.random.default_rng(1)
     alpha = (rng.random(len(src.zeta)) > 0.5).astype(float)
     got = interpolate(alpha, src, dst)
