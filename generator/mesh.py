@@ -903,8 +903,7 @@ def extrude(base: BaseMesh, gap: GapFunction, n_layers: int,
     points[..., 2] = h[:, None] * frac
     if columns == "normal":
         tilt = _column_tilt(base, gap, h)
-        points[:, 1:-1, :2] += frac[None, 1:-1, None] ** 2 * tilt[:, None, :]
-        points[:, -1, :2] += tilt
+        points[:, 1:, :2] += frac[None, 1:, None] ** 2 * tilt[:, None, :]   # f = 1: the ball
         inner = points[:, 1:, :2].reshape(-1, 2)
         points[:, 1:, 2] = (np.asarray(gap(inner[:, 0], inner[:, 1]), float)
                             .reshape(len(points2), L) * frac[None, 1:])
