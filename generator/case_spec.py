@@ -289,6 +289,10 @@ class Run(BaseModel):
             (docs/cases.md: the air's pressure drops are some 6 % of the capillary
             pressure). 1 is the physical air.
         pressure_correctors: PIMPLE's nCorrectors (pressure solutions per time step).
+        alpha_subcycles: MULES sub-cycles of the oil fraction per time step
+            (nAlphaSubCycles); None keeps the template's (1 in the interface scenes, 3 in
+            the cavitating one). 3 calms a resting meniscus (docs/cases.md, "Sub-cycles
+            and the capillary limit").
         n_procs: MPI ranks (1: serial).
     """
 
@@ -305,6 +309,7 @@ class Run(BaseModel):
     capillary_safety: float = Field(2.0, gt=0.0, le=100.0)
     air_viscosity_factor: float = Field(100.0, ge=1.0, le=1000.0)
     pressure_correctors: int = Field(3, ge=1, le=10)
+    alpha_subcycles: int | None = Field(None, ge=1, le=20)
     n_procs: int = Field(1, ge=1, le=1024)
 
 

@@ -330,6 +330,8 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
         f["solvers"]['"alpha.oil.*"']["cAlpha"] = spec.physics.interface_compression
         f["solvers"]['"alpha.oil.*"']["icAlpha"] = spec.physics.isotropic_compression
         f["PIMPLE"]["nCorrectors"] = spec.run.pressure_correctors
+        if spec.run.alpha_subcycles is not None:
+            f["solvers"]['"alpha.oil.*"']["nAlphaSubCycles"] = spec.run.alpha_subcycles
     if spec.physics.interface_schemes == "balanced":
         _balance_interface_schemes(case)
     with FoamFile(case / "system" / "decomposeParDict") as f:

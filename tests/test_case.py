@@ -55,6 +55,7 @@ def _copy(case: Path, tmp_path: Path) -> Path:
     ("[mesh]\ncolumns = \"slanted\"\n", "mesh.columns = 'slanted'", "'normal' or 'vertical'"),
     ("[contact]\ntemperature = 99.0\n", "temperature = 99 C", "valid range 25 to 60 C"),
     ("[run]\nsteady_tolerance = 2.0\n", "run.steady_tolerance = 2.0", "steady_tolerance < 1"),
+    ("[run]\nalpha_subcycles = 0\n", "run.alpha_subcycles = 0", "1 <= run.alpha_subcycles"),
     ("scene = \"gas-release\"\n[physics]\ngas_release_rate = 0.0\n",
      "physics.gas_release_rate = 0.0", "0 < physics.gas_release_rate"),
     ("scene = \"gas-release\"\n[run]\nair_viscosity_factor = 20.0\n",
@@ -134,12 +135,12 @@ def test_case_is_complete_and_runs_by_hand_layout(small_case):
 
 
 def test_time_step_options_reach_the_dictionaries(tmp_path):
-    """run.max_courant, max_alpha_courant, pressure_correctors, capillary_safety and the
-    interface compression (physics.interface_compression, isotropic_compression) are what
+    """run.max_courant, max_alpha_courant, pressure_correctors, alpha_subcycles,
+    capillary_safety and the interface compression (physics.interface_compression, isotropic_compression) are what
     controlDict and fvSolution say; the capillary limit scales with its safety factor."""
     spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "max_courant": 0.7,
                                             "max_alpha_courant": 0.6, "pressure_correctors": 2,
-                                            "capillary_safety": 1.5},
+                                            "alpha_subcycles": 4, "capillary_safety": 1.5},
                            "physics": {"interface_compression": 0.25,
                                        "isotropic_compression": 1.0}})
     geom = write_case(spec, tmp_path / "opts")
@@ -149,7 +150,7 @@ def test_time_step_options_reach_the_dictionaries(tmp_path):
     fv_solution = FoamFile(tmp_path / "opts" / "system" / "fvSolution")
     assert fv_solution["PIMPLE"]["nCorrectors"] == 2
     alpha = fv_solution["solvers"]['"alpha.oil.*"']
-    assert (alpha["cAlpha"], alpha["icAlpha"]) == (0.25, 1.0)
+    assert (alpha["cAlpha"], alpha["icAlpha"], alpha["nAlphaSubCycles"]) == (0.25, 1.0, 4)
     dx = geom.min_cell_size
     assert geom.max_delta_t == pytest.approx(min(capillary_time_step(spec, dx),
                                                  geom.write_interval))
@@ -638,24 +639,27 @@ def test_static_meniscus_stays_put(tmp_path):
     assert m["oil_volume_m3"] == pytest.approx(m["oil_volume_initial_m3"], rel=1e-3)
 
 
-def test_static_meniscus_on_the_polar_ring_moves_less_than_1_percent_of_u(tmp_path):
-    """Where the issue's 1 % holds: the coarse level with a polar ring of cells around the
-    contact (mesh.polar_radius) and weak interface compression (cAlpha 0.25), not the
-    defaults. What moves a meniscus in a thin gap is the gap-averaged oil velocity; at every
-    write of the second half of 30 ms its largest value stays below 1 % of u (measured on
-    this case: 0.66 % at most, 0.43 % at the last write; with cAlpha 1 the same mesh reaches
-    2-7 %, docs/cases.md, "A polar ring around the contact")."""
+def test_static_meniscus_moves_less_than_1_percent_of_u_in_the_quiet_configuration(tmp_path):
+    """Where the issue's 1 % holds at the default compression (cAlpha 1): the balanced
+    interface schemes, three MULES sub-cycles and a time step at 0.75 of the capillary limit,
+    on the coarse level. What moves a meniscus in a thin gap is the gap-averaged oil
+    velocity. The puddle starts as an upright cylinder of oil; the flow that curves its
+    meniscus across the gap is real and decays over some 40 ms (to 1.5 % of u). Over the last
+    quarter of 60 ms the largest gap-averaged oil speed stays below 1 % of u (bench: 0.23 %
+    coarse, 0.68 % medium; the default configuration bursts to 8-10 %, docs/cases.md,
+    "Sub-cycles and the capillary limit")."""
     speed = 0.008
     spec = make_case_spec({
-        "name": "static-ring", "walls_moving": False,
+        "name": "static-quiet", "walls_moving": False,
         "contact": {"speed": speed, "grid": SMALL["contact"]["grid"],
                     "tol_residual": SMALL["contact"]["tol_residual"]},
-        "mesh": {"resolution": "coarse", "polar_radius": 6.8},
+        "mesh": {"resolution": "coarse"},
         "supply": {"mode": "layers", "disc_layer": 0.0, "ball_layer": 0.0,
                    "initial_puddle": 3.0},
-        "physics": {"interface_compression": 0.25},
-        "run": {"end_time": 0.03, "capillary_safety": 1.0, "writes_per_transit": 200}})
-    case = tmp_path / "static-ring"
+        "physics": {"interface_schemes": "balanced"},
+        "run": {"end_time": 0.06, "capillary_safety": 0.75, "alpha_subcycles": 3,
+                "writes_per_transit": 200}})
+    case = tmp_path / "static-quiet"
     write_case(spec, case)
     m = run_case(case, wall_limit=600)
     assert m["status"] == "finished", m
@@ -668,8 +672,8 @@ def test_static_meniscus_on_the_polar_ring_moves_less_than_1_percent_of_u(tmp_pa
         alpha = np.asarray(FoamFieldFile(folder / "alpha.oil").internal_field, float)
         return st.oil_column_speeds(U, alpha)
 
-    late = max(column_speeds(folder).max() for t, folder in times if float(t) >= 0.5 * end)
-    assert late < 0.01 * speed, f"gap-averaged oil speed {late:.3g} m/s"
+    settled = max(column_speeds(folder).max() for t, folder in times if float(t) >= 0.75 * end)
+    assert settled < 0.01 * speed, f"gap-averaged oil speed {settled:.3g} m/s"
     assert m["inlet_meniscus_distance_over_a"] == pytest.approx(2.0, abs=0.1)
     assert m["oil_volume_m3"] == pytest.approx(m["oil_volume_initial_m3"], rel=1e-3)
 
