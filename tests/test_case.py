@@ -641,12 +641,11 @@ def test_static_meniscus_stays_put(tmp_path):
 
 def test_static_meniscus_moves_less_than_1_percent_of_u_in_the_quiet_configuration(tmp_path):
     """Where the issue's 1 % holds at the default compression (cAlpha 1): the balanced
-    interface schemes, three MULES sub-cycles and a time step at 0.75 of the capillary limit,
-    on the coarse level. What moves a meniscus in a thin gap is the gap-averaged oil
-    velocity. The puddle starts as an upright cylinder of oil; the flow that curves its
-    meniscus across the gap is real and decays over some 40 ms (to 1.5 % of u). Over the last
-    quarter of 60 ms the largest gap-averaged oil speed stays below 1 % of u (bench: 0.23 %
-    coarse, 0.68 % medium; the default configuration bursts to 8-10 %, docs/cases.md,
+    interface schemes, three MULES sub-cycles and a time step at half the capillary limit
+    (the quiet configuration), here on the coarse level. What moves a meniscus in a thin gap
+    is the gap-averaged oil velocity; at every write of the second half of 60 ms its largest
+    value stays below 1 % of u (bench, second half / last quarter: 0.44 / 0.27 % coarse,
+    0.92 / 0.40 % fine; the default configuration bursts to 8-10 %, docs/cases.md,
     "Sub-cycles and the capillary limit")."""
     speed = 0.008
     spec = make_case_spec({
@@ -657,7 +656,7 @@ def test_static_meniscus_moves_less_than_1_percent_of_u_in_the_quiet_configurati
         "supply": {"mode": "layers", "disc_layer": 0.0, "ball_layer": 0.0,
                    "initial_puddle": 3.0},
         "physics": {"interface_schemes": "balanced"},
-        "run": {"end_time": 0.06, "capillary_safety": 0.75, "alpha_subcycles": 3,
+        "run": {"end_time": 0.06, "capillary_safety": 0.5, "alpha_subcycles": 3,
                 "writes_per_transit": 200}})
     case = tmp_path / "static-quiet"
     write_case(spec, case)
@@ -672,8 +671,8 @@ def test_static_meniscus_moves_less_than_1_percent_of_u_in_the_quiet_configurati
         alpha = np.asarray(FoamFieldFile(folder / "alpha.oil").internal_field, float)
         return st.oil_column_speeds(U, alpha)
 
-    settled = max(column_speeds(folder).max() for t, folder in times if float(t) >= 0.75 * end)
-    assert settled < 0.01 * speed, f"gap-averaged oil speed {settled:.3g} m/s"
+    late = max(column_speeds(folder).max() for t, folder in times if float(t) >= 0.5 * end)
+    assert late < 0.01 * speed, f"gap-averaged oil speed {late:.3g} m/s"
     assert m["inlet_meniscus_distance_over_a"] == pytest.approx(2.0, abs=0.1)
     assert m["oil_volume_m3"] == pytest.approx(m["oil_volume_initial_m3"], rel=1e-3)
 
