@@ -195,9 +195,8 @@ def supply_fraction(spec: CaseSpec, mesh: PolyMesh, patch: str = "inlet") -> np.
     z = np.sort(mesh.points[faces, 2], axis=1)
     z_lo, z_hi = z[:, :2].mean(axis=1), z[:, 2:].mean(axis=1)
     # the column height at each face: the highest point of the faces above the same 2D
-    # edge (point p is a level of 2D node p // (n_layers + 1); columns may lean, so their
-    # nodes need not share a y)
-    nodes = np.sort(faces // (int(mesh.layer.max()) + 2), axis=1)
+    # edge (columns may lean, so their nodes need not share a y)
+    nodes = np.sort(mesh.base_node(faces), axis=1)
     _, inverse = np.unique(nodes[:, [0, -1]], axis=0, return_inverse=True)
     inverse = inverse.ravel()
     column = np.zeros(inverse.max() + 1)

@@ -664,6 +664,12 @@ class PolyMesh:
     def n_internal_faces(self) -> int:
         return len(self.neighbour)
 
+    def base_node(self, point_ids: np.ndarray) -> np.ndarray:
+        """The 2D base-mesh node of each point id: point ``p`` is a level of node
+        ``p // (n_layers + 1)`` (:func:`extrude`'s order), whether or not its column
+        leans."""
+        return np.asarray(point_ids) // (int(self.layer.max()) + 2)
+
     def patch(self, name: str) -> Patch:
         """The patch called ``name`` (KeyError if absent)."""
         for p in self.patches:
