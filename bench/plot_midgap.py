@@ -2,10 +2,12 @@
 report of issue 5): oil dark, air light, the island (unmeshed contact) black, the Hertzian
 circle red, the metrics in the titles.
 
-    python bench/plot_midgap.py OUT.png CASE[@TRANSITS] [CASE[@TRANSITS] ...]
+    python bench/plot_midgap.py OUT.png [--window X0,X1,Y0,Y1] CASE[@TRANSITS] [CASE[@TRANSITS] ...]
 
 CASE@2.6 shows the write nearest 2.6 transits (the state and bubble in its title then come from
 the case's history.csv at that write); a bare CASE shows the last write and its metrics.json.
+``--window -4,6,-3.5,3.5`` shows only x/a in [-4, 6] and y/a in [-3.5, 3.5] (the whole domain
+by default).
 """
 
 from __future__ import annotations
@@ -34,7 +36,12 @@ def main(argv=None) -> int:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    out, picks = Path(argv[0]), [_pick(arg) for arg in argv[1:]]
+    out, rest = Path(argv[0]), list(argv[1:])
+    window = None
+    if rest[:1] == ["--window"] and len(rest) > 2:
+        window = _window(rest[1])
+        rest = rest[2:]
+    picks = [_pick(arg) for arg in rest]
     fig, axs = plt.subplots(len(picks), 1, figsize=(7, 3.6 * len(picks)), squeeze=False,
                             gridspec_kw={"hspace": 0.45})
     for ax, (case, at) in zip(axs[:, 0], picks):
@@ -69,6 +76,9 @@ def main(argv=None) -> int:
                      + (f", bubble {fmt(m.get('bubble_length_over_a'))} a"
                         if m.get("bubble_length_over_a") else ""), fontsize=8)
         ax.set_aspect("equal")
+        if window is not None:
+            ax.set_xlim(*window[:2])
+            ax.set_ylim(*window[2:])
         ax.set_xlabel("x / a (rolling ->)")
         ax.set_ylabel("y / a")
     fig.colorbar(tc, ax=axs.ravel().tolist(), label="oil fraction at mid-gap",
@@ -78,6 +88,17 @@ def main(argv=None) -> int:
     fig.savefig(out, dpi=110, bbox_inches="tight")
     print(f"wrote {out}")
     return 0
+
+
+def _window(arg: str) -> tuple[float, float, float, float]:
+    """"X0,X1,Y0,Y1" (in units of a) -> the four limits, checked."""
+    try:
+        x0, x1, y0, y1 = (float(v) for v in arg.split(","))
+    except ValueError:
+        raise SystemExit(f"plot_midgap: --window {arg!r}: expected four numbers X0,X1,Y0,Y1 (in a)")
+    if not (x0 < x1 and y0 < y1):
+        raise SystemExit(f"plot_midgap: --window {arg!r}: needs X0 < X1 and Y0 < Y1")
+    return x0, x1, y0, y1
 
 
 def _pick(arg: str) -> tuple[Path, float | None]:

@@ -117,8 +117,10 @@ class Sample:
     oil_out_by_boundary: dict[str, float] = field(default_factory=dict)
 
     def row(self) -> dict:
-        keys = ("state", "inlet_meniscus_distance_over_a", "flooded_length_over_a",
-                "flooded_width_over_a", "wake_gas_length_over_a", "enclosed_bubbles",
+        keys = ("state", "wake_open", "inlet_starved", "inlet_meniscus_distance_over_a",
+                "inlet_meniscus_at_rim", "inlet_meniscus_shape", "inlet_meniscus_c2",
+                "flooded_length_over_a", "flooded_width_over_a", "wake_gas_length_over_a",
+                "enclosed_bubbles",
                 "bubble_length_over_a", "bubble_volume_m3", "min_pressure_Pa",
                 "gas_release_m3_s", "gas_dissolution_m3_s")
         gas = ({} if self.gas_mass is None else

@@ -24,6 +24,7 @@ from generator.case_writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_
 from runs import case_fields
 from runs.cli import parse_value
 from runs.foam_runtime import FoamRuntime
+from runs.report.case_data import read_history
 from runs.run_case import OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, run_case
 from tiny import SMALL
 
@@ -299,6 +300,12 @@ def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     rows = (case / "history.csv").read_text().splitlines()
     assert len(rows) >= 10 and rows[0].startswith("time_s,oil_volume_m3")
     assert "oil_out_outlet_m3_s" in rows[0] and "oil_out_side_m3_s" in rows[0]
+    # the shape of the inlet meniscus at every write, as metrics.json has it at the last
+    history = read_history(case / "history.csv")
+    assert m["inlet_meniscus_shape"] == "convex"        # ample oil, state I
+    assert history["inlet_meniscus_shape"][-1] == "convex"
+    assert history["inlet_meniscus_c2"][-1] == pytest.approx(m["inlet_meniscus_c2"], rel=1e-9)
+    assert set(history["wake_open"]) <= {"True", "False"}
     # where the oil leaves: split by boundary, adding up to the outflow, none upstream
     by_boundary = m["oil_outflow_by_boundary_m3_s"]
     assert set(by_boundary) == {"inlet", "outlet", "side"}
