@@ -4,7 +4,10 @@ For runs whose time folders are gone or were never brought back (a run made on a
 machine, a pruned case): the state at every write, when the wake first opened, and the mean,
 min and max over the last transit of the flow-pattern metrics and the oil volume's drift, and
 the share of the outflow that left anywhere but through the outlet (runs whose history.csv
-has the per-boundary columns).
+has the per-boundary columns). Over the last transit also how many writes had the wake open,
+the inlet meniscus at the rim, and a concave or convex inlet meniscus (with the median of its
+fitted c2): from history.csv where it has those columns (runs since 2026-11-24), else from
+the written fields where they are still there.
 
     python bench/history_summary.py CASE [CASE ...] [--save NAME.json] [--note TEXT]
 """
@@ -21,6 +24,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import RESULTS, save  # noqa: E402
+from generator.case_writer import load_geometry  # noqa: E402
+from runs import case_fields  # noqa: E402
 from runs.case_fields import off_outlet_share  # noqa: E402
 from runs.report.case_data import read_history  # noqa: E402
 
@@ -81,7 +86,38 @@ def summarise(case: str | Path) -> dict:
                                          if span > 0 else None),
         "outflow_over_inflow_last": float(out_last / in_last) if in_last > 0 else None,
         "off_outlet_fraction_last_transit": _off_outlet_share(h, last),
+        "inlet_last_transit": _inlet_counts(case, h, t[last]),
     }
+
+
+def _inlet_counts(case: Path, h: dict[str, np.ndarray], times: np.ndarray) -> dict | None:
+    """Over the writes at ``times``: how many had the wake open, the inlet meniscus at the rim,
+    a concave / convex inlet meniscus, and the median fitted c2. From history.csv's columns,
+    else re-read from the written fields (None where neither is there)."""
+    if "inlet_meniscus_shape" in h:
+        rows = np.isin(h["time_s"], times)
+        patterns = [{"wake_open": h["wake_open"][i] == "True",
+                     "inlet_meniscus_at_rim": h["inlet_meniscus_at_rim"][i] == "True",
+                     "inlet_meniscus_shape": h["inlet_meniscus_shape"][i] or None,
+                     "inlet_meniscus_c2": h["inlet_meniscus_c2"][i]}
+                    for i in np.flatnonzero(rows)]
+        source = "history.csv"
+    else:
+        folders = dict(case_fields.time_folders(case))
+        picked = [folders[t] for t in folders if np.isclose(times, t, rtol=0, atol=1e-12).any()]
+        if not picked:
+            return None
+        geom, structure = load_geometry(case), case_fields.Structure.load(case)
+        patterns = [case_fields.sample(f, structure, geom).pattern for f in picked]
+        source = "fields"
+    c2 = np.array([np.nan if p["inlet_meniscus_c2"] is None else float(p["inlet_meniscus_c2"])
+                   for p in patterns])
+    shapes = [p["inlet_meniscus_shape"] for p in patterns]
+    return {"writes": len(patterns), "source": source,
+            "wake_open": sum(bool(p["wake_open"]) for p in patterns),
+            "at_rim": sum(bool(p["inlet_meniscus_at_rim"]) for p in patterns),
+            "concave": shapes.count("concave"), "convex": shapes.count("convex"),
+            "c2_median": float(np.nanmedian(c2)) if np.isfinite(c2).any() else None}
 
 
 def _off_outlet_share(h: dict[str, np.ndarray], last: np.ndarray) -> float | None:
@@ -121,6 +157,12 @@ def main(argv=None) -> int:
               f"out/in {r['outflow_over_inflow_last']:.3f}"
             + ("" if r["off_outlet_fraction_last_transit"] is None else
                f", off the outlet {r['off_outlet_fraction_last_transit']:.1%}"))
+        inlet = r["inlet_last_transit"]
+        if inlet:
+            c2 = "-" if inlet["c2_median"] is None else f"{inlet['c2_median']:+.3f}"
+            print(f"   last transit, of {inlet['writes']} writes ({inlet['source']}): wake open "
+                  f"{inlet['wake_open']}, inlet meniscus at the rim {inlet['at_rim']}, concave "
+                  f"{inlet['concave']}, convex {inlet['convex']}, median c2 {c2}")
     if args.save:
         print(save(args.save, {"note": args.note, "rows": rows}))
     return 0
