@@ -1,4 +1,5 @@
-"""Static meniscus: walls at rest, no supply, an oil puddle of radius 3a around the island.
+"""Static meniscus: walls at rest, no supply, an oil puddle of radius 3a (or supply.initial_puddle)
+around the island.
 
 The puddle is an equilibrium (the gap is axisymmetric) once its meniscus, set up as an upright
 cylinder, has curved across the gap (some 40 ms); from then on every velocity is spurious. Prints
@@ -142,7 +143,9 @@ def main(argv=None) -> int:
                "air_viscosity_in_solver": mu_air * spec.run.air_viscosity_factor,
                "max_delta_t_s": geom.max_delta_t, "cells": geom.cells,
                "status": m["status"], "time_steps": m["time_steps"], "wall_s": m["wall_s"],
-               "meniscus_drift_over_a": abs(m["inlet_meniscus_distance_over_a"] - 2.0)
+               # the inlet meniscus is measured from x = -a, the puddle's radius from the centre
+               "meniscus_drift_over_a": abs(m["inlet_meniscus_distance_over_a"] + 1.0
+                                            - spec.supply.initial_puddle)
                if m.get("inlet_meniscus_distance_over_a") is not None else None,
                "oil_volume_change": m["oil_volume_m3"] / m["oil_volume_initial_m3"] - 1.0,
                **s, **{k.replace("u_", "ratio_") + "_over_u": v / args.speed
