@@ -96,8 +96,8 @@ def _inlet_counts(case: Path, h: dict[str, np.ndarray], times: np.ndarray) -> di
     else re-read from the written fields (None where neither is there)."""
     if "inlet_meniscus_shape" in h:
         rows = np.isin(h["time_s"], times)
-        patterns = [{"wake_open": h["wake_open"][i] == "True",
-                     "inlet_meniscus_at_rim": h["inlet_meniscus_at_rim"][i] == "True",
+        patterns = [{"wake_open": h["wake_open"][i],
+                     "inlet_meniscus_at_rim": h["inlet_meniscus_at_rim"][i],
                      "inlet_meniscus_shape": h["inlet_meniscus_shape"][i] or None,
                      "inlet_meniscus_c2": h["inlet_meniscus_c2"][i]}
                     for i in np.flatnonzero(rows)]

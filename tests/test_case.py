@@ -305,7 +305,7 @@ def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     assert m["inlet_meniscus_shape"] == "convex"        # ample oil, state I
     assert history["inlet_meniscus_shape"][-1] == "convex"
     assert history["inlet_meniscus_c2"][-1] == pytest.approx(m["inlet_meniscus_c2"], rel=1e-9)
-    assert set(history["wake_open"]) <= {"True", "False"}
+    assert set(history["wake_open"]) <= {True, False}
     # where the oil leaves: split by boundary, adding up to the outflow, none upstream
     by_boundary = m["oil_outflow_by_boundary_m3_s"]
     assert set(by_boundary) == {"inlet", "outlet", "side"}

@@ -115,8 +115,13 @@ def _load_spec(case: Path, problems: list[str]) -> tuple[Any, dict]:
         return None, raw
 
 
+_FLAGS = {"True": True, "False": False}
+
+
 def read_history(path: Path) -> dict[str, np.ndarray] | None:
-    """history.csv as columns: floats (NaN for empty cells), ``state`` as text."""
+    """history.csv as columns: floats (NaN for empty cells), ``state`` as text, and the
+    flags written as True/False (``wake_open``, ``inlet_meniscus_at_rim``, ...) as Python
+    booleans (None for empty cells), so that a written "False" does not read as true."""
     try:
         with open(path, newline="") as fh:
             rows = list(csv.DictReader(fh))
@@ -129,6 +134,9 @@ def read_history(path: Path) -> dict[str, np.ndarray] | None:
         values = [r.get(key) or "" for r in rows]
         if key == "state":
             out[key] = np.array(values, dtype=object)
+            continue
+        if set(values) & _FLAGS.keys() and set(values) <= _FLAGS.keys() | {"", "None"}:
+            out[key] = np.array([_FLAGS.get(v) for v in values], dtype=object)
             continue
         try:
             out[key] = np.array([float(v) if v not in ("", "None") else math.nan for v in values])
