@@ -34,7 +34,7 @@ TRACKED = ("inlet_meniscus_distance_over_a", "flooded_length_over_a", "flooded_w
            "bubble_length_over_a", "oil_volume_m3")
 #: ... and these where the run wrote them (the gas scenes; older histories lack some)
 TRACKED_IF_WRITTEN = ("bubble_volume_m3", "min_pressure_Pa", "gas_release_m3_s",
-                      "gas_dissolution_m3_s")
+                      "gas_dissolution_m3_s", "oil_smeared_fraction")
 
 
 def summarise(case: str | Path) -> dict:

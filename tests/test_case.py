@@ -306,6 +306,9 @@ def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     assert history["inlet_meniscus_shape"][-1] == "convex"
     assert history["inlet_meniscus_c2"][-1] == pytest.approx(m["inlet_meniscus_c2"], rel=1e-9)
     assert set(history["wake_open"]) <= {True, False}
+    # the share of the oil in smeared interface cells: in metrics.json and history's last row
+    assert 0.0 < m["oil_smeared_fraction"] < 1.0
+    assert history["oil_smeared_fraction"][-1] == pytest.approx(m["oil_smeared_fraction"])
     # where the oil leaves: split by boundary, adding up to the outflow, none upstream
     by_boundary = m["oil_outflow_by_boundary_m3_s"]
     assert set(by_boundary) == {"inlet", "outlet", "side"}

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from generator.case_writer import CaseGeometry
-from runs.case_fields import Sample, gas_dissolution, gas_release
+from runs.case_fields import Sample, gas_dissolution, gas_release, smeared_oil_fraction
 from runs.run_case import dissolved_air_budget, mass_balance, steady_test
 
 
@@ -147,3 +147,14 @@ def test_dissolved_air_budget_compares_the_release_with_all_the_oil():
     for s in h:
         s.pattern["gas_release_m3_s"] = None                        # a scene without release
     assert dissolved_air_budget(h, air_solubility=0.1, window=0.6) == {}
+
+
+def test_smeared_oil_fraction_counts_the_oil_in_cells_that_are_neither_oil_nor_air():
+    # oil volumes 1 + 1 + 0 + 0.99 + 0.01 + 1 = 4 (the overshoot 1.2 clipped to 1; unclipped
+    # the share would be 1 / 4.2); only the half-full cell (volume 2) is smeared: 0.99 and
+    # 0.01 lie outside (0.02, 0.98)
+    alpha = np.array([1.0, 0.5, 0.0, 0.99, 0.01, 1.2])
+    volumes = np.array([1.0, 2.0, 3.0, 1.0, 1.0, 1.0])
+    assert smeared_oil_fraction(alpha, volumes) == pytest.approx(1.0 / 4.0)
+    assert smeared_oil_fraction(np.zeros(3), np.ones(3)) is None        # no oil
+    assert smeared_oil_fraction(np.full(2, 0.5), np.ones(2)) == pytest.approx(1.0)

@@ -34,6 +34,7 @@ METRICS: dict[str, Unit] = {
     "enclosed_bubbles": ("Enclosed gas regions", "", None),
     "oil_area_fraction": ("Oil area fraction (mid-gap, alpha >= 0.5)", "%", 100.0),
     "mean_alpha": ("Mean mid-gap oil fraction", "", 1.0),
+    "oil_smeared_fraction": ("Oil in smeared interface cells (0.02 < alpha < 0.98)", "%", 100.0),
     "bubble_length_over_a": ("Bubble length from x = a", "a", 1.0),
     "bubble_width_over_a": ("Bubble width", "a", 1.0),
     "bubble_volume_m3": ("Bubble volume", "nl", 1e12),
