@@ -134,7 +134,11 @@ class Physics(BaseModel):
             step it keeps a resting meniscus at 5-7 a, where the nominal rolling one sits,
             below 0.5 % of u on all three levels (the standard schemes: 1.1-16 %, growing
             with refinement); the nominal case then settles on the medium level in 825 s,
-            coarse first ("The static meniscus where the rolling one sits").
+            coarse first ("The static meniscus where the rolling one sits"). On the
+            leaning columns the uncorrected gradients change nothing, at rest or rolling;
+            the normal and the limited flux do both, and the rolling region then fills
+            slowly (still 0.95 of the inflow out after 26 transits on coarse) with 44-48 %
+            of its oil in partly filled cells ("What calms the resting meniscus").
         ambient_pressure: [Pa, absolute] at the open boundaries (cavitating scene; the
             interface scene works in gauge pressure and adds it only to report one).
         cavitation_pressure: [Pa, absolute] the pressure floor of the cavitating scene
