@@ -93,15 +93,18 @@ def foam_edit(text: str) -> tuple[str, tuple[str, ...], object]:
     file, colon, path = target.partition(":")
     if not sep or not colon or not path:
         raise argparse.ArgumentTypeError(f"--edit wants FILE:KEY/SUBKEY=VALUE, got {text!r}")
-    words = value.split()
-    if len(words) > 1:
-        return file, tuple(path.split("/")), tuple(words)
+    words = tuple(_word_or_number(w) for w in value.split())
+    return file, tuple(path.split("/")), words if len(words) > 1 else _word_or_number(value)
+
+
+def _word_or_number(word: str) -> int | float | str:
+    """A scheme's word as the number it spells (``limitedLinear01 1``'s 1), else the word."""
     for kind in (int, float):
         try:
-            return file, tuple(path.split("/")), kind(value)
+            return kind(word)
         except ValueError:
             pass
-    return file, tuple(path.split("/")), value
+    return word
 
 
 def apply_edits(case: Path, edits: list, solver: str = "") -> None:
