@@ -38,10 +38,12 @@ TRACKED_IF_WRITTEN = ("bubble_volume_m3", "min_pressure_Pa", "gas_release_m3_s",
 
 
 def summarise(case: str | Path) -> dict:
-    """The summary of one case folder (needs ``history.csv`` and ``metrics.json``)."""
+    """The summary of one case folder (needs ``history.csv`` and ``metrics.json``; a run
+    killed before its end has only the monitor's first ``metrics.json``: the transit time
+    then comes from the case's geometry)."""
     case = Path(case)
     metrics = json.loads((case / "metrics.json").read_text())
-    transit = metrics["transit_time_s"]
+    transit = metrics.get("transit_time_s") or load_geometry(case).transit_time
     h = read_history(case / "history.csv")
     t, states = h["time_s"], [str(x) for x in h["state"]]
     opened = next((float(ti) for ti, st in zip(t, states) if st == "II"), None)
@@ -146,8 +148,9 @@ def main(argv=None) -> int:
         largest = "none" if largest is None else f"{largest:.2f} a"
         balance = r["oil_mass_balance_error"]
         balance = "-" if balance is None else f"{balance:.2%}"
+        wall = "-" if r["wall_s"] is None else f"{r['wall_s']:.0f} s"   # None: killed
         print(f"{r['case']}: {r['cells']} cells, {r['transits_written']:.2f} transits written, "
-              f"{r['time_steps']} steps, {r['wall_s']:.0f} s wall, end {r['end_reason']}; "
+              f"{r['time_steps']} steps, {wall} wall, end {r['end_reason']}; "
               f"states {r['states_per_write']}; first open {opened}; largest enclosed "
               f"bubble before it {largest}; oil balance {balance}")
         print("   last transit: " + ", ".join(

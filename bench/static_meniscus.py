@@ -137,7 +137,7 @@ def main(argv=None) -> int:
         row = {"level": level, "cAlpha": c_alpha, "capillary_safety": safety, "nHat": nhat,
                "options": dict(args.set), "solver": args.solver,
                "edits": [f"{file}:{'/'.join(keys)}="
-                         f"{' '.join(value) if isinstance(value, tuple) else value}"
+                         f"{' '.join(map(str, value)) if isinstance(value, tuple) else value}"
                          for file, keys, value in args.edit],
                "air_viscosity": mu_air,
                "air_viscosity_in_solver": mu_air * spec.run.air_viscosity_factor,
