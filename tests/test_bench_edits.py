@@ -1,0 +1,43 @@
+"""The benchmarks' ``--edit FILE:KEY/SUBKEY=VALUE`` (bench/common.py): what it writes into a
+case file is what OpenFOAM reads, schemes with numbers in them included."""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+from pathlib import Path
+
+import pytest
+from foamlib import FoamFile
+
+from bench.common import apply_edits, foam_edit
+
+TEMPLATE = Path(__file__).resolve().parents[1] / "templates" / "interface"
+
+
+def test_a_scheme_with_numbers_is_written_as_openfoam_reads_it(tmp_path):
+    case = tmp_path / "case"
+    shutil.copytree(TEMPLATE / "system", case / "system")
+    edits = [foam_edit("fvSchemes:divSchemes/div(phirb,alpha)=Gauss limitedLinear01 1"),
+             foam_edit("fvSchemes:divSchemes/div(phi,alpha)="
+                       "Gauss CoBlended 0.001 vanLeer01 0.005 linear"),
+             foam_edit("fvSchemes:gradSchemes/nHat=pointCellsLeastSquares"),
+             foam_edit("fvSolution:PIMPLE/nCorrectors=4")]
+    assert edits[0] == ("fvSchemes", ("divSchemes", "div(phirb,alpha)"),
+                        ("Gauss", "limitedLinear01", 1))
+    apply_edits(case, edits)
+    with FoamFile(case / "system" / "fvSchemes") as f:
+        assert f["divSchemes"]["div(phirb,alpha)"] == ("Gauss", "limitedLinear01", 1)
+        assert f["divSchemes"]["div(phi,alpha)"] == (
+            "Gauss", "CoBlended", 0.001, "vanLeer01", 0.005, "linear")
+        assert f["gradSchemes"]["nHat"] == "pointCellsLeastSquares"
+    text = (case / "system" / "fvSchemes").read_text()
+    assert "div(phirb,alpha) Gauss limitedLinear01 1;" in text
+    with FoamFile(case / "system" / "fvSolution") as f:
+        assert f["PIMPLE"]["nCorrectors"] == 4
+
+
+@pytest.mark.parametrize("bad", ["fvSchemes:divSchemes", "divSchemes/x=1", "fvSchemes:=1"])
+def test_a_malformed_edit_is_refused_with_its_text(bad):
+    with pytest.raises(argparse.ArgumentTypeError, match="FILE:KEY/SUBKEY=VALUE"):
+        foam_edit(bad)
