@@ -136,8 +136,9 @@ class Physics(BaseModel):
             with refinement); the nominal case then settles on the medium level in 825 s,
             coarse first ("The static meniscus where the rolling one sits"). On the
             leaning columns the uncorrected gradients change nothing, at rest or rolling;
-            the normal and the limited flux do both, and the rolling region then fills
-            slowly (still 0.95 of the inflow out after 26 transits on coarse) with 44-48 %
+            the normal and the limited flux do both, and the rolling region then grows
+            narrower and longer, holds more oil and so balances later (still 0.95 of the
+            inflow out after 26 transits on coarse), with 44-48 %
             of its oil in partly filled cells ("What calms the resting meniscus").
         ambient_pressure: [Pa, absolute] at the open boundaries (cavitating scene; the
             interface scene works in gauge pressure and adds it only to report one).
