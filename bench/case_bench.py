@@ -3,7 +3,7 @@ state per resolution level, with the flow-pattern metrics each level gives.
 
     python bench/case_bench.py [--levels coarse medium fine] [--speed 0.008]
         [--supply layers --layer 2e-6 --track 3e-4] [--jobs 2] [--wall-limit 3600]
-        [--sequence] [--start-from LEVEL] [--procs N] [--set KEY=VALUE ...] [--collect]
+        [--sequence] [--start-from LEVEL|CASE] [--procs N] [--set KEY=VALUE ...] [--collect]
 
 Each level runs serially (one core; ``--procs`` ranks with mpirun); ``--jobs`` runs levels side
 by side. ``--sequence`` runs the levels one after the other, each starting from the previous
@@ -60,6 +60,15 @@ def one(level: str, args: argparse.Namespace, previous: str | None = None) -> di
     return row_of(case, level, previous, build_s)
 
 
+def start_case(folder: Path, given: str) -> str:
+    """What ``--start-from`` names, as :func:`one` joins it to the tag's ``folder``: a level
+    already run there (a sibling case) if there is one of that name, else the path ``given``
+    (relative to the working directory) of any finished case, made absolute."""
+    if (folder / given).is_dir() or not Path(given).is_dir():
+        return given
+    return str(Path(given).resolve())
+
+
 def row_of(case: Path, level: str, previous: str | None, build_s: float | None = None) -> dict:
     """The table row of a run case (its metrics.json and the solver's CPU time)."""
     m = json.loads((case / "metrics.json").read_text())
@@ -82,9 +91,10 @@ def main(argv=None) -> int:
     ap.add_argument("--sequence", action="store_true",
                     help="each level starts from the previous level's final fields")
     ap.add_argument("--procs", type=int, default=1, help="MPI ranks per case")
-    ap.add_argument("--start-from", default=None, metavar="LEVEL",
+    ap.add_argument("--start-from", default=None, metavar="LEVEL|CASE",
                     help="the first level starts from the final fields of LEVEL, already run "
-                         "under --tag (grid sequencing without re-running LEVEL)")
+                         "under --tag (grid sequencing without re-running LEVEL), or of the "
+                         "finished case at the path CASE (another tag, another mesh)")
     ap.add_argument("--collect", action="store_true",
                     help="only tabulate the levels already run under --tag")
     ap.add_argument("--set", action="append", default=[], type=spec_option, metavar="KEY=VALUE",
@@ -100,7 +110,7 @@ def main(argv=None) -> int:
     previous = {level: (args.levels[i - 1] if i and args.sequence else None)
                 for i, level in enumerate(args.levels)}
     if args.start_from:
-        previous[args.levels[0]] = args.start_from
+        previous[args.levels[0]] = start_case(Path(args.work) / args.tag, args.start_from)
     if args.collect:
         rows = [row_of(Path(args.work) / args.tag / level, level, previous[level])
                 for level in args.levels

@@ -41,3 +41,22 @@ def test_a_scheme_with_numbers_is_written_as_openfoam_reads_it(tmp_path):
 def test_a_malformed_edit_is_refused_with_its_text(bad):
     with pytest.raises(argparse.ArgumentTypeError, match="FILE:KEY/SUBKEY=VALUE"):
         foam_edit(bad)
+
+
+def test_start_from_names_a_level_of_the_tag_or_any_finished_case(tmp_path, monkeypatch):
+    """bench/case_bench.py --start-from: a level already run under the tag wins; else a path
+    from the working directory, made absolute so that joining it to the tag's folder (as
+    ``one`` does) gives that case; the older form relative to the new case's folder still
+    works."""
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[1] / "bench"))
+    from case_bench import start_case
+
+    tag = tmp_path / "work" / "tag"
+    (tag / "medium").mkdir(parents=True)
+    other = tmp_path / "elsewhere" / "fine"
+    other.mkdir(parents=True)
+    monkeypatch.chdir(tmp_path)
+    assert start_case(tag, "medium") == "medium"
+    assert (tag / start_case(tag, "elsewhere/fine")).resolve() == other.resolve()
+    assert Path(start_case(tag, "elsewhere/fine")).is_absolute()
+    assert (tag / start_case(tag, "../../elsewhere/fine")).resolve() == other.resolve()
