@@ -97,6 +97,12 @@ def foam_edit(text: str) -> tuple[str, tuple[str, ...], object]:
     return file, tuple(path.split("/")), words if len(words) > 1 else _word_or_number(value)
 
 
+def edit_value_text(value: object, sep: str = " ") -> str:
+    """The VALUE of a :func:`foam_edit` as text again, its words joined by ``sep`` (``""``
+    for a folder name)."""
+    return sep.join(map(str, value)) if isinstance(value, tuple) else str(value)
+
+
 def _word_or_number(word: str) -> int | float | str:
     """A scheme's word as the number it spells (``limitedLinear01 1``'s 1), else the word."""
     for kind in (int, float):

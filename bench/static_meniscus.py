@@ -36,7 +36,7 @@ from foamlib import FoamFieldFile  # noqa: E402
 
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
-from common import apply_edits, foam_edit, spec_option  # noqa: E402
+from common import apply_edits, edit_value_text, foam_edit, spec_option  # noqa: E402
 from runs import case_fields  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
@@ -120,9 +120,8 @@ def main(argv=None) -> int:
                     "writes_per_transit": 200}}, **dict(args.set))
         name = f"{level}_c{c_alpha:g}_s{safety:g}_air{mu_air:g}_t{args.time:g}" + "".join(
             f"_{key.split('.')[-1]}{value}" for key, value in args.set) + "".join(
-            f"_{keys[-1]}{''.join(map(str, value)) if isinstance(value, tuple) else value}"
-            for _, keys, value in args.edit) + ("" if args.solver == "interFoam" else
-                                                f"_{args.solver}")
+            f"_{keys[-1]}{edit_value_text(value, '')}" for _, keys, value in args.edit) + (
+            "" if args.solver == "interFoam" else f"_{args.solver}")
         case = Path(args.work) / (name if nhat == "default" else f"{name}_{nhat.replace(' ', '')}")
         if args.reanalyse and (case / "metrics.json").exists():
             geom = load_geometry(case)
@@ -136,8 +135,7 @@ def main(argv=None) -> int:
         s = spurious(case)
         row = {"level": level, "cAlpha": c_alpha, "capillary_safety": safety, "nHat": nhat,
                "options": dict(args.set), "solver": args.solver,
-               "edits": [f"{file}:{'/'.join(keys)}="
-                         f"{' '.join(map(str, value)) if isinstance(value, tuple) else value}"
+               "edits": [f"{file}:{'/'.join(keys)}={edit_value_text(value)}"
                          for file, keys, value in args.edit],
                "air_viscosity": mu_air,
                "air_viscosity_in_solver": mu_air * spec.run.air_viscosity_factor,

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from foamlib import FoamFile
 
-from bench.common import apply_edits, foam_edit
+from bench.common import apply_edits, edit_value_text, foam_edit
 
 TEMPLATE = Path(__file__).resolve().parents[1] / "templates" / "interface"
 
@@ -25,6 +25,10 @@ def test_a_scheme_with_numbers_is_written_as_openfoam_reads_it(tmp_path):
              foam_edit("fvSolution:PIMPLE/nCorrectors=4")]
     assert edits[0] == ("fvSchemes", ("divSchemes", "div(phirb,alpha)"),
                         ("Gauss", "limitedLinear01", 1))
+    # as the static bench names the record's edit and the case folder
+    assert edit_value_text(edits[0][2]) == "Gauss limitedLinear01 1"
+    assert edit_value_text(edits[0][2], "") == "GausslimitedLinear011"
+    assert edit_value_text(edits[3][2]) == "4"
     apply_edits(case, edits)
     with FoamFile(case / "system" / "fvSchemes") as f:
         assert f["divSchemes"]["div(phirb,alpha)"] == ("Gauss", "limitedLinear01", 1)
