@@ -223,6 +223,8 @@ class Mesh(BaseModel):
         resolution: "coarse", "medium" or "fine".
         n_layers: cells across the gap (None: the level's value).
         size_rim, size_far: in-plane cell size at the island rim / far away, units of a.
+            The nominal menisci sit in cells of about size_far, and the flooded width
+            depends on it (docs/cases.md, "The far field decides the width").
         wall_grading: mid-gap cell height over wall cell height (1: uniform layers); finer
             cells at the walls carry the supply layers and the films left behind.
         polar_radius: outer radius, units of a, of a structured polar ring of cells around
