@@ -314,17 +314,17 @@ def _write_scalar_list(path: Path, values: np.ndarray) -> None:
 
 
 def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
+    edit_physics_dicts(spec, case)
+    edit_run_control(spec, case, geom.end_time, geom.write_interval, geom.max_delta_t)
+
+
+def edit_physics_dicts(spec: CaseSpec, case: Path) -> None:
+    """Write ``spec``'s fluids, interface numerics and decomposition into the template's
+    constant/ and system/ dictionaries of ``case`` (everything but the run control)."""
     if spec.scene == "cavitating":
         _edit_thermo(spec, case)
     else:
         _edit_transport(spec, case)
-    with FoamFile(case / "system" / "controlDict") as f:
-        f["application"] = spec.solver
-        f["endTime"] = geom.end_time
-        f["writeInterval"] = geom.write_interval
-        f["maxCo"] = spec.run.max_courant
-        f["maxAlphaCo"] = spec.run.max_alpha_courant
-        f["maxDeltaT"] = geom.max_delta_t
     with FoamFile(case / "system" / "fvSolution") as f:
         f["solvers"]['"alpha.oil.*"']["cAlpha"] = spec.physics.interface_compression
         f["solvers"]['"alpha.oil.*"']["icAlpha"] = spec.physics.isotropic_compression
@@ -336,6 +336,19 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
     with FoamFile(case / "system" / "decomposeParDict") as f:
         f["numberOfSubdomains"] = spec.run.n_procs
         f["coeffs"]["n"] = [spec.run.n_procs, 1, 1]
+
+
+def edit_run_control(spec: CaseSpec, case: Path, end_time: float, write_interval: float,
+                     max_delta_t: float) -> None:
+    """system/controlDict: the solver, the time limit and write interval [s], the Courant
+    limits and the largest step [s] (the capillary limit, :func:`capillary_time_step`)."""
+    with FoamFile(case / "system" / "controlDict") as f:
+        f["application"] = spec.solver
+        f["endTime"] = end_time
+        f["writeInterval"] = write_interval
+        f["maxCo"] = spec.run.max_courant
+        f["maxAlphaCo"] = spec.run.max_alpha_courant
+        f["maxDeltaT"] = max_delta_t
 
 
 def _balance_interface_schemes(case: Path) -> None:

@@ -1,0 +1,248 @@
+"""The rear meniscus's films on a strip: the least model of what sets the flooded width.
+
+Behind the contact the flooded region sends its oil out as films that its rear meniscus lays
+on the disc and the ball. A receding meniscus between walls moving at u lays, on both walls
+together, the fraction LL(Ca) of the gap h where it sits (Landau-Levich, Aussillous and Quere's
+fit: ``bench/wall_films.py``). So at balance the meniscus sits where LL h equals the oil
+carried in over u: the films decide how far back, in the diverging gap, the region reaches,
+and with it its size (docs/cases.md, "The far field decides the width").
+
+This bench asks, in 2D (x, z), what the cases' meshes make of that law. A strip one cell wide
+(empty sides) along y = 0 of the nominal case's gap, x from ``--x-in`` to ``--x-out``, both
+walls rolling at u, is fed all-oil through x = x_in at q = u ``--film`` (m2/s) and starts as a
+bridge of oil up to where LL puts the meniscus. For each in-plane cell size dx (a) and level
+(the wall layers and the capillary step of that level, at that dx) it records, at every
+write, the rear meniscus (the gap-averaged oil fraction crossing 0.5), the films behind it
+(the oil over the gap, a median over x_r + 1 a .. x_out - 0.5 a) and the oil held, and prints
+the deposited fraction f = film / h(x_r) against LL, and where the meniscus would balance,
+h* = film_in / f.
+
+    python bench/film_deposition.py [--dx 0.8 0.4 0.2 0.1 0.05] [--levels coarse]
+        [--film 4e-6] [--time 1.0] [--set KEY=VALUE ...] [--work DIR] [--reuse]
+        [--save NAME.json]
+"""
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import shutil
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from foamlib import FoamFieldFile  # noqa: E402
+
+from bench.common import save, spec_option  # noqa: E402
+from bench.wall_films import landau_levich  # noqa: E402
+from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
+from generator.case_writer import (TEMPLATES, capillary_time_step,  # noqa: E402
+                                   edit_physics_dicts, edit_run_control)
+from generator.gap_source import load_gap  # noqa: E402
+from generator.mesh import BaseMesh, PolyMesh, extrude, split_patch, write_polymesh  # noqa: E402
+from runs.foam_runtime import FoamRuntime  # noqa: E402
+
+
+def strip_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float) -> PolyMesh:
+    """The strip x in [x_in, x_out] (m), one cell of dx (m) wide in y, extruded across the gap
+    on y = 0 with the level's wall layers; patches supply (x_in), outlet, disc, ball and
+    side (both y faces, empty: a 2D case)."""
+    n = max(int(round((x_out - x_in) / dx)), 1)
+    x = np.linspace(x_in, x_out, n + 1)
+    points = np.concatenate([np.stack([x, np.zeros_like(x)], 1),
+                             np.stack([x, np.full_like(x, dx)], 1)])
+    i = np.arange(n)
+    quads = np.stack([i, i + 1, n + 2 + i, n + 1 + i], 1)          # counter-clockwise
+    edges = {"inlet": np.array([[n + 1, 0]]), "outlet": np.array([[n, 2 * n + 1]]),
+             "side": np.concatenate([np.stack([i, i + 1], 1),
+                                     np.stack([n + 2 + i, n + 1 + i], 1)])}
+    level = spec.mesh.level()
+    mesh = extrude(BaseMesh(points, quads, edges), lambda xs, ys: gap(xs, np.zeros_like(xs)),
+                   level["n_layers"], level["wall_grading"], spec.mesh.columns)
+    mesh = split_patch(mesh, "inlet", np.ones(mesh.patch("inlet").size, bool), "supply")
+    mesh.patches = [replace(p, type="empty") if p.name == "side" else p for p in mesh.patches]
+    return mesh
+
+
+def columns(mesh: PolyMesh, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per column of the strip: x on the disc (m), gap (m) and oil thickness (m, both walls
+    together)."""
+    x_nodes = np.unique(mesh.points[mesh.points[:, 2] == 0.0, 0])   # the disc's nodes
+    footprint = np.diff(x_nodes) * np.ptp(mesh.points[:, 1])
+    n = len(footprint)
+    x = 0.5 * (x_nodes[:-1] + x_nodes[1:])
+    gap_h = np.bincount(mesh.base_cell, mesh.cell_volumes, minlength=n) / footprint
+    oil = np.bincount(mesh.base_cell, mesh.cell_volumes * np.clip(alpha, 0.0, 1.0),
+                      minlength=n) / footprint
+    return x, gap_h, oil
+
+
+def write_strip_case(spec: CaseSpec, case: Path, mesh: PolyMesh, x_bridge: float,
+                     film: float, dx: float, end_time: float, write_interval: float) -> float:
+    """The interface template with the strip mesh, the bridge (oil for x < x_bridge, m), the
+    all-oil supply carrying ``film`` * u (m2/s) and the level's capillary step for cells of
+    dx (m). Returns that step (s)."""
+    if case.exists():
+        shutil.rmtree(case)
+    for part in ("system", "constant", "0.orig"):
+        shutil.copytree(TEMPLATES / "interface" / part, case / part)
+    write_polymesh(mesh, case)
+    u = spec.wall_speed
+    h_in = mesh.points[mesh.faces[mesh.patch_slice("supply")], 2].max()   # the gap at x_in
+    with FoamFieldFile(case / "0.orig" / "U") as f:
+        f.boundary_field["disc"]["value"] = np.array([u, 0.0, 0.0])
+        f.boundary_field["ball"]["origin"] = np.array([0.0, 0.0, spec.contact.radius])
+        f.boundary_field["ball"]["omega"] = -u / spec.contact.radius
+        f.boundary_field["supply"]["value"] = np.array([u * film / h_in, 0.0, 0.0])
+        f.boundary_field["side"] = {"type": "empty"}
+    with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
+        f.internal_field = (mesh.cell_centres[:, 0] < x_bridge).astype(float)
+        f.boundary_field['"(disc|ball|island)"']["theta0"] = spec.physics.contact_angle
+        f.boundary_field["supply"]["value"] = 1.0
+        f.boundary_field["side"] = {"type": "empty"}
+    with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
+        f.boundary_field["side"] = {"type": "empty"}
+    edit_physics_dicts(spec, case)
+    dt = capillary_time_step(spec, dx)
+    edit_run_control(spec, case, end_time, write_interval, min(dt, write_interval))
+    shutil.copytree(case / "0.orig", case / "0")
+    return dt
+
+
+def x_at_gap(gap, h: float, x_lo: float, x_hi: float) -> float:
+    """The x (m) on y = 0 between x_lo and x_hi where the gap is h (m), by bisection."""
+    g = lambda x: float(gap(np.array([x]), np.array([0.0]))[0]) - h  # noqa: E731
+    if g(x_lo) * g(x_hi) > 0:
+        return float("nan")
+    for _ in range(60):
+        mid = 0.5 * (x_lo + x_hi)
+        x_lo, x_hi = (mid, x_hi) if g(x_lo) * g(mid) > 0 else (x_lo, mid)
+    return 0.5 * (x_lo + x_hi)
+
+
+def measure(case: Path, mesh: PolyMesh, a: float, x_out: float) -> list[dict]:
+    """At every write: the rear meniscus x_r/a and the gap there (m), the films behind it (m,
+    both walls) and the oil held per metre of width (m2)."""
+    x, h, _ = columns(mesh, np.zeros(len(mesh.cell_volumes)))
+    rows = []
+    times = sorted((float(d.name), d) for d in case.iterdir()
+                   if d.is_dir() and _is_number(d.name) and float(d.name) > 0)
+    for t, folder in times:
+        alpha = np.asarray(FoamFieldFile(folder / "alpha.oil").internal_field, float)
+        _, _, oil = columns(mesh, alpha)
+        frac = oil / h
+        dry = np.flatnonzero(frac < 0.5)
+        if not len(dry) or dry[0] == 0:
+            continue
+        k = dry[0]
+        w = (frac[k - 1] - 0.5) / (frac[k - 1] - frac[k])
+        x_r = x[k - 1] + w * (x[k] - x[k - 1])
+        h_r = h[k - 1] + w * (h[k] - h[k - 1])
+        behind = (x > x_r + a) & (x < x_out - 0.5 * a)
+        film = float(np.median(oil[behind])) if behind.any() else float("nan")
+        rows.append({"t_s": t, "x_rear_over_a": x_r / a, "gap_rear_m": h_r, "film_m": film,
+                     "deposited_fraction": film / h_r,
+                     "oil_per_width_m2": float(oil.sum() * np.diff(x).mean())})
+    return rows
+
+
+def _run_or_reuse(runtime: FoamRuntime, spec: CaseSpec, case: Path, mesh: PolyMesh,
+                  x_bridge: float, args: argparse.Namespace, dx: float) -> dict:
+    """Write and run the strip case, or, with ``--reuse``, take the run already in ``case``
+    (its ``run.json``) when it ran the same time. Returns the run's step limit (s), status,
+    wall time (s) and steps."""
+    record = case / "run.json"
+    if args.reuse and record.exists():
+        run = json.loads(record.read_text())
+        if run["end_time_s"] == args.time and run["status"] == "ok":
+            return run
+    dt = write_strip_case(spec, case, mesh, x_bridge, args.film, dx, args.time,
+                          args.time / args.writes)
+    t0 = time.perf_counter()
+    proc = runtime.run("interFoam", cwd=case, log_path=case / "log.interFoam", check=False)
+    run = {"max_delta_t_s": dt, "end_time_s": args.time,
+           "status": "ok" if proc.returncode == 0 else "failed",
+           "wall_s": time.perf_counter() - t0, "steps": proc.stdout.count("\nTime = ")}
+    record.write_text(json.dumps(run) + "\n")
+    return run
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--dx", nargs="+", type=float, default=[0.8, 0.4, 0.2, 0.1, 0.05],
+                    help="in-plane cell sizes [a]")
+    ap.add_argument("--levels", nargs="+", default=["coarse"],
+                    help="levels whose wall layers and capillary safety are used")
+    ap.add_argument("--film", type=float, default=4e-6,
+                    help="oil carried in, as a film thickness at the rolling speed [m]")
+    ap.add_argument("--x-in", type=float, default=3.0, help="supply at x = X a")
+    ap.add_argument("--x-out", type=float, default=16.0, help="outlet at x = X a")
+    ap.add_argument("--time", type=float, default=1.0, help="simulated time [s]")
+    ap.add_argument("--writes", type=int, default=50, help="writes over the run")
+    ap.add_argument("--set", action="append", default=[], type=spec_option,
+                    metavar="KEY=VALUE", help="any other spec option (e.g. mesh.n_layers=20)")
+    ap.add_argument("--work", type=Path, default=ROOT / "runs" / "bench" / "film_deposition")
+    ap.add_argument("--reuse", action="store_true",
+                    help="measure a case already run to --time in --work instead of re-running")
+    ap.add_argument("--save", help="record name under bench/results/ (written after each case)")
+    ap.add_argument("--note", default="")
+    args = ap.parse_args(argv)
+    for name, value in (("--film", args.film), ("--time", args.time)):
+        if not value > 0:
+            ap.error(f"{name}: {value} (valid range > 0)")
+    if not 1.5 <= args.x_in < args.x_out:
+        ap.error(f"--x-in {args.x_in}, --x-out {args.x_out}: need 1.5 <= x_in < x_out (a)")
+    runtime = FoamRuntime.from_environment()
+    results = []
+    for level, dx_a in itertools.product(args.levels, args.dx):
+        spec = make_case_spec({"mesh": {"resolution": level}}, **dict(args.set))
+        gap, _ = load_gap(spec.contact)
+        a = spec.a
+        ll = landau_levich(spec.oil_viscosity, spec.speed, spec.physics.surface_tension)
+        x_ll = x_at_gap(gap, args.film / ll, args.x_in * a, args.x_out * a)
+        mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
+        case = args.work / (f"{level}_dx{dx_a:g}" + "".join(
+            f"_{k.split('.')[-1]}{v}" for k, v in args.set))
+        run = _run_or_reuse(runtime, spec, case, mesh, x_ll, args, dx_a * a)
+        rows = measure(case, mesh, a, args.x_out * a)
+        late = [r for r in rows if r["t_s"] >= 0.6 * args.time]
+        f = float(np.median([r["deposited_fraction"] for r in late])) if late else float("nan")
+        h_star = args.film / f
+        result = {"level": level, "dx_over_a": dx_a, "dx_m": dx_a * a, "cells": mesh.n_cells,
+                  **run,
+                  "landau_levich": ll, "x_rear_landau_levich_over_a": x_ll / a,
+                  "deposited_fraction_late_median": f,
+                  "deposited_over_landau_levich": f / ll,
+                  "x_rear_balance_over_a": x_at_gap(gap, h_star, args.x_in * a,
+                                                    3 * args.x_out * a) / a,
+                  "x_rear_last_over_a": rows[-1]["x_rear_over_a"] if rows else None,
+                  "options": dict(args.set), "writes": rows}
+        results.append(result)
+        print(f"{level:>7} dx {dx_a:5.3g} a ({dx_a * a * 1e6:5.1f} um) {mesh.n_cells:6d} cells "
+              f"{result['steps']:6d} steps {result['wall_s']:6.0f} s {result['status']}: deposited "
+              f"{f * 100:5.2f} % of the gap (LL {ll * 100:4.2f} %, x{f / ll:5.2f}); rear "
+              f"{result['x_rear_last_over_a'] or float('nan'):6.2f} a at the end, balance "
+              f"{result['x_rear_balance_over_a']:6.2f} a (LL {x_ll / a:5.2f} a)", flush=True)
+        if args.save:   # after every case: an interrupted sweep keeps what it measured
+            save(args.save, {"note": args.note,
+                             "args": {k: str(v) for k, v in vars(args).items()},
+                             "rows": results})
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
