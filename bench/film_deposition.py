@@ -46,6 +46,7 @@ from generator.case_writer import (TEMPLATES, capillary_time_step,  # noqa: E402
                                    edit_physics_dicts, edit_run_control)
 from generator.gap_source import load_gap  # noqa: E402
 from generator.mesh import BaseMesh, PolyMesh, extrude, split_patch, write_polymesh  # noqa: E402
+from runs import case_fields  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
 
 
@@ -131,9 +132,7 @@ def measure(case: Path, mesh: PolyMesh, a: float, x_out: float) -> list[dict]:
     both walls) and the oil held per metre of width (m2)."""
     x, h, _ = columns(mesh, np.zeros(len(mesh.cell_volumes)))
     rows = []
-    times = sorted((float(d.name), d) for d in case.iterdir()
-                   if d.is_dir() and _is_number(d.name) and float(d.name) > 0)
-    for t, folder in times:
+    for t, folder in case_fields.time_folders(case):
         alpha = np.asarray(FoamFieldFile(folder / "alpha.oil").internal_field, float)
         _, _, oil = columns(mesh, alpha)
         frac = oil / h
@@ -171,14 +170,6 @@ def _run_or_reuse(runtime: FoamRuntime, spec: CaseSpec, case: Path, mesh: PolyMe
            "wall_s": time.perf_counter() - t0, "steps": proc.stdout.count("\nTime = ")}
     record.write_text(json.dumps(run) + "\n")
     return run
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def main(argv: list[str] | None = None) -> int:
