@@ -42,6 +42,7 @@ import math
 from pathlib import Path
 from typing import Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ehl_precalc.spec import PrecalcSpec, SpecError, range_text, read_toml
@@ -216,6 +217,41 @@ class Domain(BaseModel):
         return self
 
 
+#: how fast, in a of cell size per a of distance, the cells grow back from a refinement box
+#: (mesh.refine) to the level's size: 0.1 a cells reach 0.55 a within 1.8 a
+REFINE_GROWTH = 0.25
+
+
+class RefineBox(BaseModel):
+    """A box of finer in-plane cells (``mesh.refine``), units of a: x in [x_min, x_max],
+    |y| in [y_min, y_max], cells of ``size`` there, growing back to the level's size at
+    :data:`REFINE_GROWTH` outside. It refines the free quads only: the polar ring keeps its
+    cells. For the films the rear meniscus lays (docs/cases.md, "The films decide the width")."""
+
+    model_config = _STRICT
+    x_min: float = Field(ge=-200.0, le=200.0)
+    x_max: float = Field(ge=-200.0, le=200.0)
+    y_min: float = Field(0.0, ge=0.0, le=200.0)
+    y_max: float = Field(gt=0.0, le=200.0)
+    size: float = Field(gt=0.0, le=10.0)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "RefineBox":
+        if not self.x_min < self.x_max:
+            raise ValueError(f"x_min = {self.x_min:g} a must be below x_max = {self.x_max:g} a")
+        if not self.y_min < self.y_max:
+            raise ValueError(f"y_min = {self.y_min:g} a must be below y_max = {self.y_max:g} a")
+        return self
+
+    def size_at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Cell size (a) this box asks for at (x, y) (a): its size inside, growing with the
+        distance outside."""
+        dx = np.maximum(np.maximum(self.x_min - x, x - self.x_max), 0.0)
+        ay = np.abs(y)
+        dy = np.maximum(np.maximum(self.y_min - ay, ay - self.y_max), 0.0)
+        return self.size + REFINE_GROWTH * np.hypot(dx, dy)
+
+
 class Mesh(BaseModel):
     """Resolution level (see :data:`RESOLUTIONS`) and optional overrides.
 
@@ -238,6 +274,10 @@ class Mesh(BaseModel):
             column so that it meets every layer at right angles (an in-plane shift of a
             few um at most), "vertical" keeps them upright, which makes every face where
             the ball slopes non-orthogonal (docs/cases.md, "Columns across the gap").
+        refine: boxes of finer in-plane cells (:class:`RefineBox`), e.g.
+            ``[{x_min = 5, x_max = 14, y_max = 8, size = 0.1}]`` where the rear meniscus and
+            the region's shoulders sit: the films they lay converge only in cells of 0.05-0.1
+            a (docs/cases.md, "The films decide the width"). Empty by default.
     """
 
     model_config = _STRICT
@@ -248,6 +288,7 @@ class Mesh(BaseModel):
     wall_grading: float | None = Field(None, ge=1.0, le=100.0)
     polar_radius: float | Literal["auto"] | None = "auto"
     columns: Literal["normal", "vertical"] = "normal"
+    refine: tuple[RefineBox, ...] = ()
 
     @field_validator("polar_radius", mode="before")
     @classmethod

@@ -108,13 +108,17 @@ class CaseGeometry:
 def size_function(spec: CaseSpec):
     """In-plane cell size [m] at (x, y): size_rim at the island rim, growing in proportion to
     the distance from the contact centre (the gap grows like r^2, the meniscus sits a few a
-    out), capped at size_far."""
+    out), capped at size_far; smaller where a refinement box (mesh.refine) asks for it."""
     level, a, ri = spec.mesh.level(), spec.a, spec.domain.island_radius * spec.a
     rim, far = level["size_rim"] * a, level["size_far"] * a
+    boxes = spec.mesh.refine
 
     def size(x, y):
-        r = np.hypot(np.asarray(x, float), np.asarray(y, float))
-        return np.clip(rim * r / ri, rim, far)
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        out = np.clip(rim * np.hypot(x, y) / ri, rim, far)
+        for box in boxes:
+            out = np.minimum(out, box.size_at(x / a, y / a) * a)
+        return out
 
     return size
 

@@ -180,6 +180,41 @@ def test_meshed_gap_matches_the_gap_export(level, ring):
     assert gap_mismatch(mesh, gap) < 0.01
 
 
+def test_a_refinement_box_refines_the_free_quads_inside_it():
+    """mesh.refine: quads of about the box's size inside it, the level's outside, the cells
+    growing back at REFINE_GROWTH in between; a box that is not a box is refused naming it."""
+    from generator.case_spec import REFINE_GROWTH
+    from generator.case_writer import size_function
+    from generator.mesh import MeshParams, build_base_mesh
+
+    def base(spec):
+        a, d = spec.a, spec.domain
+        params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
+                            island_radius=d.island_radius * a, n_layers=2,
+                            polar_radius=spec.polar_radius * a)
+        mesh = build_base_mesh(params, size_function(spec))
+        centre = mesh.points[mesh.quads].mean(axis=1) / a
+        return centre, np.sqrt(mesh.quad_areas()) / a
+
+    box = {"x_min": 4.0, "x_max": 6.5, "y_min": 0.0, "y_max": 4.5, "size": 0.2}
+    plain = make_case_spec(SMALL)
+    boxed = make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": [box]}})
+    size = size_function(boxed)
+    a = boxed.a
+    assert size(5.0 * a, 2.0 * a) == pytest.approx(0.2 * a)
+    assert size(5.0 * a, -2.0 * a) == pytest.approx(0.2 * a)          # |y|: the full domain
+    assert size(5.0 * a, 5.0 * a) == pytest.approx((0.2 + REFINE_GROWTH * 0.5) * a)
+    assert size(-4.0 * a, 0.0) == pytest.approx(size_function(plain)(-4.0 * a, 0.0))
+    (c0, s0), (c1, s1) = base(plain), base(boxed)
+    inside = lambda c: (c[:, 0] > 4.3) & (c[:, 0] < 6.2) & (c[:, 1] < 4.2)  # noqa: E731
+    upstream = lambda c: c[:, 0] < -3.0  # noqa: E731
+    assert np.median(s1[inside(c1)]) == pytest.approx(0.2, rel=0.2)
+    assert np.median(s0[inside(c0)]) > 2.5 * 0.2
+    assert np.median(s1[upstream(c1)]) == pytest.approx(np.median(s0[upstream(c0)]), rel=0.05)
+    with pytest.raises(SpecError, match=r"mesh.refine.0: y_min = 5 a must be below y_max = 4.5"):
+        make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": [{**box, "y_min": 5.0}]}})
+
+
 def test_allrun_runs_by_hand(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:
