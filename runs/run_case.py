@@ -47,6 +47,10 @@ POLL_S = 1.0
 STOP_GRACE_S = 120.0
 DT_COLLAPSE = 1e-4          # time step below this fraction of maxDeltaT counts as collapse
 DT_COLLAPSE_STEPS = 200     # ... for this many consecutive logged steps
+#: share of the outflow leaving off the outlet above which a run is flagged: the region (or a
+#: wall film) reached the side or upstream boundary, e.g. a width of 15.5 a against a side at
+#: 8 a (docs/cases.md, "The films decide the width")
+OFF_OUTLET_WARNING = 0.05
 
 
 class CaseBusy(RuntimeError):
@@ -439,6 +443,16 @@ def _raise_interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
+def boundary_warnings(off_outlet: float | None) -> list[str]:
+    """A warning when more than :data:`OFF_OUTLET_WARNING` of the oil leaving the domain
+    (``off_outlet``, the share at the last write) did not leave through the outlet."""
+    if off_outlet is None or off_outlet <= OFF_OUTLET_WARNING:
+        return []
+    return [f"{off_outlet:.0%} of the outflow left through the side or upstream boundary "
+            f"(above {OFF_OUTLET_WARNING:.0%}): the flooded region or a wall film reached it, "
+            f"so the region is cut short; widen the domain (domain.side, domain.upstream)"]
+
+
 def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, tail, wall, case) -> dict:
     last = history[-1] if history else None
     pattern = dict(last.pattern) if last else {}
@@ -472,7 +486,8 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "speed_m_s": geom.speed,
         "mesh_gap_mismatch": geom.gap_mismatch,
         "ball_wall_steps": geom.ball_wall_steps,
-        "warnings": "; ".join(mesh_warnings(geom)),
+        "warnings": "; ".join(mesh_warnings(geom) + boundary_warnings(
+            case_fields.off_outlet_share(last.oil_out_by_boundary) if last else None)),
     }
     if failed:
         log = case / geom.log_name

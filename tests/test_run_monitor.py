@@ -8,7 +8,8 @@ import pytest
 
 from generator.case_writer import CaseGeometry
 from runs.case_fields import Sample, gas_dissolution, gas_release, smeared_oil_fraction
-from runs.run_case import dissolved_air_budget, mass_balance, steady_test
+from runs.run_case import (OFF_OUTLET_WARNING, boundary_warnings, dissolved_air_budget,
+                           mass_balance, steady_test)
 
 
 def history(volumes, menisci, dt=0.01, state="I"):
@@ -158,3 +159,15 @@ def test_smeared_oil_fraction_counts_the_oil_in_cells_that_are_neither_oil_nor_a
     assert smeared_oil_fraction(alpha, volumes) == pytest.approx(1.0 / 4.0)
     assert smeared_oil_fraction(np.zeros(3), np.ones(3)) is None        # no oil
     assert smeared_oil_fraction(np.full(2, 0.5), np.ones(2)) == pytest.approx(1.0)
+
+
+def test_a_region_spilling_over_the_side_is_flagged_and_one_inside_is_not():
+    from runs.case_fields import off_outlet_share
+    # the coarse level at size_far 0.2 a reaching the 8 a side: 53-61 % off the outlet
+    spilling = off_outlet_share({"outlet": 0.45, "side": 0.55, "inlet": 0.0})
+    [warning] = boundary_warnings(spilling)
+    assert warning.startswith("55% of the outflow left through the side or upstream")
+    assert "domain.side" in warning
+    assert boundary_warnings(off_outlet_share({"outlet": 0.996, "side": 0.004})) == []
+    assert boundary_warnings(OFF_OUTLET_WARNING) == []
+    assert boundary_warnings(None) == []
