@@ -33,6 +33,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from scipy.optimize import brentq
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
@@ -117,14 +118,13 @@ def write_strip_case(spec: CaseSpec, case: Path, mesh: PolyMesh, x_bridge: float
 
 
 def x_at_gap(gap, h: float, x_lo: float, x_hi: float) -> float:
-    """The x (m) on y = 0 between x_lo and x_hi where the gap is h (m), by bisection."""
-    g = lambda x: float(gap(np.array([x]), np.array([0.0]))[0]) - h  # noqa: E731
+    """The x (m) on y = 0 between x_lo and x_hi where the gap is h (m); NaN where the gap does
+    not pass h there."""
+    def g(x: float) -> float:
+        return float(gap(np.array([x]), np.array([0.0]))[0]) - h
     if g(x_lo) * g(x_hi) > 0:
         return float("nan")
-    for _ in range(60):
-        mid = 0.5 * (x_lo + x_hi)
-        x_lo, x_hi = (mid, x_hi) if g(x_lo) * g(mid) > 0 else (x_lo, mid)
-    return 0.5 * (x_lo + x_hi)
+    return brentq(g, x_lo, x_hi, xtol=1e-12)
 
 
 def measure(case: Path, mesh: PolyMesh, a: float, x_out: float) -> list[dict]:

@@ -26,6 +26,7 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import RESULTS  # noqa: E402
 from bench.fill_extrapolation import analyse  # noqa: E402
+from generator.case_spec import Mesh  # noqa: E402
 from generator.case_writer import load_spec_of  # noqa: E402
 
 
@@ -45,18 +46,15 @@ def strip_table() -> dict[tuple[int, float], dict[float, dict]]:
                 continue
             layers = _layers(row)
             old = table[layers].get(row["dx_over_a"])
-            if old is None or old["steps"] * old["max_delta_t_s"] < row["steps"] * row["max_delta_t_s"]:
+            if old is None or old["end_time_s"] < row["end_time_s"]:
                 table[layers][row["dx_over_a"]] = row
     return table
 
 
 def _layers(row: dict) -> tuple[int, float]:
-    from generator.case_spec import RESOLUTIONS
-    level = dict(RESOLUTIONS[row["level"]])
-    for key, value in row.get("options", {}).items():
-        name = key.split(".")[-1]
-        if name in ("n_layers", "wall_grading"):
-            level[name] = value
+    """The strip row's wall layers: its level with the row's n_layers / wall_grading options."""
+    overrides = {key.split(".")[-1]: value for key, value in row.get("options", {}).items()}
+    level = Mesh(resolution=row["level"], **overrides).level()
     return int(level["n_layers"]), float(level["wall_grading"])
 
 

@@ -456,6 +456,7 @@ def boundary_warnings(off_outlet: float | None) -> list[str]:
 def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, tail, wall, case) -> dict:
     last = history[-1] if history else None
     pattern = dict(last.pattern) if last else {}
+    off_outlet = case_fields.off_outlet_share(last.oil_out_by_boundary) if last else None
     out = {
         "status": "failed" if failed else ("interrupted" if reason == "interrupted" else "finished"),
         "end_reason": reason,
@@ -469,8 +470,7 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "oil_inflow_m3_s": last.oil_in if last else None,
         "oil_outflow_m3_s": last.oil_out if last else None,
         "oil_outflow_by_boundary_m3_s": dict(last.oil_out_by_boundary) if last else None,
-        "oil_outflow_off_outlet_fraction": (case_fields.off_outlet_share(last.oil_out_by_boundary)
-                                            if last else None),
+        "oil_outflow_off_outlet_fraction": off_outlet,
         **mass_balance(history),
         **dissolved_air_budget(history, geom.air_solubility, geom.transit_time),
         "contact_flow_m3_s": geom.contact_flow,
@@ -486,8 +486,7 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "speed_m_s": geom.speed,
         "mesh_gap_mismatch": geom.gap_mismatch,
         "ball_wall_steps": geom.ball_wall_steps,
-        "warnings": "; ".join(mesh_warnings(geom) + boundary_warnings(
-            case_fields.off_outlet_share(last.oil_out_by_boundary) if last else None)),
+        "warnings": "; ".join(mesh_warnings(geom) + boundary_warnings(off_outlet)),
     }
     if failed:
         log = case / geom.log_name
