@@ -51,6 +51,11 @@ from runs import case_fields  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
 
 
+#: the strip's default ends, units of a: the supply well upstream of LL's rear meniscus
+#: (10.3 a), the outlet far enough behind it for the films to be measured over 2 a or more
+X_IN, X_OUT = 3.0, 16.0
+
+
 def strip_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float) -> PolyMesh:
     """The strip x in [x_in, x_out] (m), one cell of dx (m) wide in y, extruded across the gap
     on y = 0 with the level's wall layers; patches supply (x_in), outlet, disc, ball and
@@ -122,7 +127,7 @@ def x_at_gap(gap, h: float, x_lo: float, x_hi: float) -> float:
     not pass h there."""
     def g(x: float) -> float:
         return float(gap(np.array([x]), np.array([0.0]))[0]) - h
-    if g(x_lo) * g(x_hi) > 0:
+    if not np.isfinite(h) or not g(x_lo) * g(x_hi) <= 0:    # NaN: no film measured
         return float("nan")
     return brentq(g, x_lo, x_hi, xtol=1e-12)
 
@@ -180,8 +185,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="levels whose wall layers and capillary safety are used")
     ap.add_argument("--film", type=float, default=4e-6,
                     help="oil carried in, as a film thickness at the rolling speed [m]")
-    ap.add_argument("--x-in", type=float, default=3.0, help="supply at x = X a")
-    ap.add_argument("--x-out", type=float, default=16.0, help="outlet at x = X a")
+    ap.add_argument("--x-in", type=float, default=X_IN, help="supply at x = X a")
+    ap.add_argument("--x-out", type=float, default=X_OUT, help="outlet at x = X a")
     ap.add_argument("--time", type=float, default=1.0, help="simulated time [s]")
     ap.add_argument("--writes", type=int, default=50, help="writes over the run")
     ap.add_argument("--set", action="append", default=[], type=spec_option,
@@ -206,7 +211,9 @@ def main(argv: list[str] | None = None) -> int:
         ll = landau_levich(spec.oil_viscosity, spec.speed, spec.physics.surface_tension)
         x_ll = x_at_gap(gap, args.film / ll, args.x_in * a, args.x_out * a)
         mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
-        case = args.work / (f"{level}_dx{dx_a:g}" + "".join(
+        strip = ("" if (args.x_in, args.x_out) == (X_IN, X_OUT)
+                 else f"_x{args.x_in:g}-{args.x_out:g}")
+        case = args.work / (f"{level}_dx{dx_a:g}{strip}" + "".join(
             f"_{k.split('.')[-1]}{v}" for k, v in args.set))
         run = _run_or_reuse(runtime, spec, case, mesh, x_ll, args, dx_a * a)
         rows = measure(case, mesh, a, args.x_out * a)

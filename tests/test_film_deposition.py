@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from foamlib import FoamFile
 
-from bench.film_deposition import columns, measure, strip_mesh, write_strip_case
+from bench.film_deposition import columns, measure, strip_mesh, write_strip_case, x_at_gap
 from generator.case_spec import make_case_spec
 from generator.gap_source import load_gap
 from runs.foam_runtime import FoamRuntime
@@ -34,6 +34,16 @@ def test_the_strip_columns_hold_the_gap_and_the_oil(strip):
     assert np.allclose(columns(mesh, half)[2], np.where(x < 6 * a, h, 0.0))
     assert {p.name: p.type for p in mesh.patches}["side"] == "empty"
     assert mesh.patch("supply").size == SMALL["mesh"]["n_layers"]
+
+
+def test_where_the_gap_is_h_and_where_no_film_was_measured(strip):
+    spec, gap, a, mesh = strip
+    h8 = float(gap(np.array([8 * a]), np.array([0.0]))[0])
+    assert x_at_gap(gap, h8, 3 * a, 10 * a) == pytest.approx(8 * a, rel=1e-6)
+    # no film measured (a failed run): NaN, not a root finder's error
+    assert np.isnan(x_at_gap(gap, float("nan"), 3 * a, 10 * a))
+    # a gap outside the range
+    assert np.isnan(x_at_gap(gap, 10 * h8, 3 * a, 10 * a))
 
 
 def test_a_fed_bridge_runs_and_lays_films_behind_its_rear_meniscus(strip, tmp_path):
