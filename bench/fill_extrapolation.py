@@ -102,7 +102,8 @@ def extrapolate(rows: list[dict], n_fit: int) -> dict:
 
 
 def analyse(case: str | Path, n_fit: int) -> dict:
-    """Per-transit rows and both readings of one case folder."""
+    """Per-transit rows and both readings of one case folder (no readings, None, before
+    three whole transits)."""
     case = Path(case)
     metrics = json.loads((case / "metrics.json").read_text())
     transit = metrics.get("transit_time_s") or load_geometry(case).transit_time
@@ -112,12 +113,15 @@ def analyse(case: str | Path, n_fit: int) -> dict:
             "folder": str(case.resolve().relative_to(ROOT)) if case.resolve().is_relative_to(ROOT)
             else str(case),
             "end_reason": metrics.get("end_reason"), "per_transit": rows,
-            "balance": extrapolate(rows, n_fit)}
+            "balance": extrapolate(rows, n_fit) if len(rows) >= 3 else None}
 
 
 def _print(result: dict) -> None:
     b = result["balance"]
     last = result["per_transit"][-1]
+    if b is None:
+        print(f"{result['folder']}: {last['transit']} transits, too few to extrapolate")
+        return
     print(f"{result['folder']}: {last['transit']} transits, oil {last['oil_volume_m3'] * 1e12:.1f}"
           f" nl, fill rate {b['fill_rate_last']:.3f} (fit over transits "
           f"{b['fit_transits'][0]}-{b['fit_transits'][1]})")
