@@ -445,12 +445,20 @@ def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any
     inlet = None if inlet_x is None else max(0.0, float((-a - inlet_x) / a))
     shape, c2 = _meniscus_shape(r, flooded, threshold)
 
-    length = width = x_lo = x_hi = None
+    length = width = x_lo = x_hi = clearance = nearest = None
     if flooded.any():
         alpha = np.nan_to_num(r.alpha, nan=0.0)
         x_lo, x_hi = _extent(flooded, alpha, gas, r.x, threshold)
         y_lo, y_hi = _extent(flooded.T, alpha.T, gas.T, r.y, threshold)
         length, width = float((x_hi - x_lo) / a), float((y_hi - y_lo) / a)
+        # the flooded region's distance to each open boundary (the raster is the full,
+        # mirrored domain: the side edges are at -y_max and y_max)
+        gaps = {"upstream": x_lo - r.geom.x_min, "outlet": r.geom.x_max - x_hi,
+                "side": r.geom.y_max - max(y_hi, -y_lo)}
+        least = min(gaps.values())
+        # ties within a pixel named in a fixed order, so that sampling cannot flip the name
+        nearest = next(k for k in ("outlet", "side", "upstream") if gaps[k] <= least + r.dx)
+        clearance = max(0.0, float(least / a))
         x_lo, x_hi = x_lo / a, x_hi / a
 
     wake_end = _wake_gas_end(r, gas, oil, threshold)
@@ -466,6 +474,8 @@ def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any
         "flooded_width_over_a": width,
         "flooded_x_min_over_a": x_lo,
         "flooded_x_max_over_a": x_hi,
+        "flooded_clearance_over_a": clearance,
+        "flooded_nearest_boundary": nearest,
         "wake_gas_length_over_a": float(wake),
         "wake_open": wake_open,
         "inlet_starved": inlet_starved,
@@ -507,6 +517,11 @@ def flow_pattern(x: Any, y: Any, alpha: Any, geom: Geometry, threshold: float = 
     ``flooded_x_min_over_a``, ``flooded_x_max_over_a``
         extents of the flooded region (oil connected to the island rim) in
         the full picture, to the interpolated crossings; None without one.
+    ``flooded_clearance_over_a``, ``flooded_nearest_boundary``
+        the flooded region's distance to the nearest open boundary (>= 0) and
+        which: "outlet" (``x_max``), "side" (``|y| = y_max``) or "upstream"
+        (``x_min``), the first of these within a pixel of the least; None
+        without a flooded region. Near 0 the region is cut short by the domain.
     ``wake_gas_length_over_a``
         if gas follows the island rim downstream on ``y = 0``, from
         ``x = a`` to the end of that gas run (next gas->oil crossing or

@@ -51,6 +51,11 @@ DT_COLLAPSE_STEPS = 200     # ... for this many consecutive logged steps
 #: wall film) reached the side or upstream boundary, e.g. a width of 15.5 a against a side at
 #: 8 a (docs/cases.md, "The films decide the width")
 OFF_OUTLET_WARNING = 0.05
+#: flooded region nearer an open boundary than this (units a) is flagged: its meniscus feels
+#: the boundary's fixed pressure, and at the outlet the oil leaves in bulk instead of as the
+#: films the rear meniscus lays (a film-resolving run's rear reached 13.5 a against a 14 a
+#: outlet, docs/cases.md "What the films converge to")
+CLEARANCE_WARNING = 1.0
 
 
 class CaseBusy(RuntimeError):
@@ -443,14 +448,29 @@ def _raise_interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
-def boundary_warnings(off_outlet: float | None) -> list[str]:
-    """A warning when more than :data:`OFF_OUTLET_WARNING` of the oil leaving the domain
-    (``off_outlet``, the share at the last write) did not leave through the outlet."""
-    if off_outlet is None or off_outlet <= OFF_OUTLET_WARNING:
-        return []
-    return [f"{off_outlet:.0%} of the outflow left through the side or upstream boundary "
-            f"(above {OFF_OUTLET_WARNING:.0%}): the flooded region or a wall film reached it, "
-            f"so the region is cut short; widen the domain (domain.side, domain.upstream)"]
+#: the spec key that moves each open boundary
+_BOUNDARY_KEY = {"upstream": "domain.upstream", "outlet": "domain.downstream",
+                 "side": "domain.side"}
+
+
+def boundary_warnings(off_outlet: float | None, pattern: dict | None = None) -> list[str]:
+    """Warnings when more than :data:`OFF_OUTLET_WARNING` of the oil leaving the domain
+    (``off_outlet``, the share at the last write) did not leave through the outlet, and when
+    the flooded region of the last write (``pattern``: its ``flooded_clearance_over_a`` and
+    ``flooded_nearest_boundary``) is within :data:`CLEARANCE_WARNING` of an open boundary."""
+    out = []
+    if off_outlet is not None and off_outlet > OFF_OUTLET_WARNING:
+        out.append(f"{off_outlet:.0%} of the outflow left through the side or upstream boundary "
+                   f"(above {OFF_OUTLET_WARNING:.0%}): the flooded region or a wall film reached "
+                   f"it, so the region is cut short; widen the domain (domain.side, "
+                   f"domain.upstream)")
+    clearance = (pattern or {}).get("flooded_clearance_over_a")
+    if clearance is not None and clearance < CLEARANCE_WARNING:
+        where = pattern["flooded_nearest_boundary"]
+        out.append(f"the flooded region is {clearance:.2f} a from the {where} boundary (below "
+                   f"{CLEARANCE_WARNING:g} a): the boundary may hold or cut it; move it out "
+                   f"({_BOUNDARY_KEY[where]})")
+    return out
 
 
 def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, tail, wall, case) -> dict:
@@ -486,7 +506,7 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "speed_m_s": geom.speed,
         "mesh_gap_mismatch": geom.gap_mismatch,
         "ball_wall_steps": geom.ball_wall_steps,
-        "warnings": "; ".join(mesh_warnings(geom) + boundary_warnings(off_outlet)),
+        "warnings": "; ".join(mesh_warnings(geom) + boundary_warnings(off_outlet, pattern)),
     }
     if failed:
         log = case / geom.log_name

@@ -130,6 +130,28 @@ def test_open_wake_is_state_two():
     assert m["enclosed_bubbles"] == 0
 
 
+def test_clearance_to_the_nearest_open_boundary():
+    # the ring of radius 4 a in x in [-6, 12] a, |y| <= 6 a: 2 a from the upstream edge
+    # and from the sides, a tie named "side"
+    m = pattern(ring)
+    assert m["flooded_clearance_over_a"] == pytest.approx(2.0, abs=TOL)
+    assert m["flooded_nearest_boundary"] == "side"
+    # shifted 1 a upstream: 1 a from the upstream edge
+    m = pattern(lambda x, y: ring(x + A, y))
+    assert m["flooded_clearance_over_a"] == pytest.approx(1.0, abs=TOL)
+    assert m["flooded_nearest_boundary"] == "upstream"
+    # a region reaching back to 11.5 a: half an a from the outlet
+    m = pattern(lambda x, y: np.minimum(ring(x, y), box(x, y, 0.0, 11.5 * A, 2 * A)))
+    assert m["flooded_clearance_over_a"] == pytest.approx(0.5, abs=TOL)
+    assert m["flooded_nearest_boundary"] == "outlet"
+    # one 5.5 a wide each side: half an a from the side, also in the full domain
+    wide = lambda x, y: np.minimum(ring(x, y), box(x, y, -2 * A, 2 * A, 5.5 * A))  # noqa: E731
+    for geom in (GEOM, FULL):
+        m = pattern(wide, geom)
+        assert m["flooded_clearance_over_a"] == pytest.approx(0.5, abs=TOL)
+        assert m["flooded_nearest_boundary"] == "side"
+
+
 def test_enclosed_bubble_behind_contact_is_state_one():
     m = pattern(enclosed_bubble)
     assert m["state"] == "I"

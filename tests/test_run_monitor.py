@@ -8,8 +8,8 @@ import pytest
 
 from generator.case_writer import CaseGeometry
 from runs.case_fields import Sample, gas_dissolution, gas_release, smeared_oil_fraction
-from runs.run_case import (OFF_OUTLET_WARNING, boundary_warnings, dissolved_air_budget,
-                           mass_balance, steady_test)
+from runs.run_case import (CLEARANCE_WARNING, OFF_OUTLET_WARNING, boundary_warnings,
+                           dissolved_air_budget, mass_balance, steady_test)
 
 
 def history(volumes, menisci, dt=0.01, state="I"):
@@ -171,3 +171,21 @@ def test_a_region_spilling_over_the_side_is_flagged_and_one_inside_is_not():
     assert boundary_warnings(off_outlet_share({"outlet": 0.996, "side": 0.004})) == []
     assert boundary_warnings(OFF_OUTLET_WARNING) == []
     assert boundary_warnings(None) == []
+
+
+def test_a_region_near_an_open_boundary_is_flagged():
+    # a film-resolving run's rear meniscus at 13.5 a against the 14 a outlet
+    [warning] = boundary_warnings(0.0, {"flooded_clearance_over_a": 0.5,
+                                        "flooded_nearest_boundary": "outlet"})
+    assert warning.startswith("the flooded region is 0.50 a from the outlet boundary")
+    assert "domain.downstream" in warning
+    [warning] = boundary_warnings(None, {"flooded_clearance_over_a": 0.2,
+                                         "flooded_nearest_boundary": "side"})
+    assert "domain.side" in warning
+    assert boundary_warnings(0.0, {"flooded_clearance_over_a": CLEARANCE_WARNING,
+                                   "flooded_nearest_boundary": "side"}) == []
+    assert boundary_warnings(0.0, {"flooded_clearance_over_a": None,
+                                   "flooded_nearest_boundary": None}) == []
+    # both at once: spilled over the side and still touching it
+    assert len(boundary_warnings(0.55, {"flooded_clearance_over_a": 0.0,
+                                        "flooded_nearest_boundary": "side"})) == 2

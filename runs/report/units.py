@@ -28,6 +28,9 @@ METRICS: dict[str, Unit] = {
     "flooded_width_over_a": ("Flooded region width (y)", "a", 1.0),
     "flooded_x_min_over_a": ("Flooded region upstream end x", "a", 1.0),
     "flooded_x_max_over_a": ("Flooded region downstream end x", "a", 1.0),
+    "flooded_clearance_over_a": ("Flooded region's distance to the nearest open boundary",
+                                 "a", 1.0),
+    "flooded_nearest_boundary": ("Open boundary nearest the flooded region", "", None),
     "wake_gas_length_over_a": ("Gas behind the contact on y = 0, from x = a", "a", 1.0),
     "wake_open": ("Wake open (outer air reaches the contact exit)", "", None),
     "inlet_starved": ("Inlet starved (outer air reaches the contact inlet)", "", None),
@@ -61,7 +64,7 @@ METRICS: dict[str, Unit] = {
     "gas_release_over_dissolved_air": ("Gas released / air the oil holds dissolved", "%", 100.0),
     "gas_release_over_dissolved_inflow": ("Gas release / dissolved air the supply brings, "
                                           "last transit", "%", 100.0),
-    "warnings": ("Warnings (mesh)", "", None),
+    "warnings": ("Warnings (mesh, open boundaries)", "", None),
     "ball_wall_steps": ("Ball wall steps per cell (median; above 10 a film creeps)", "", 1.0),
     "contact_flow_m3_s": ("Flow through the contact, u hc 2a", "nl/s", 1e12),
     "contact_flow_over_inflow": ("Contact flow / oil inflow", "%", 100.0),
