@@ -54,6 +54,8 @@ from runs.foam_runtime import FoamRuntime  # noqa: E402
 #: the strip's default ends, units of a: the supply well upstream of LL's rear meniscus
 #: (10.3 a), the outlet far enough behind it for the films to be measured over 2 a or more
 X_IN, X_OUT = 3.0, 16.0
+#: the nominal feed [m]: the strip carries u times this in, which LL balances at 10.3 a
+FILM = 4e-6
 
 
 def strip_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float) -> PolyMesh:
@@ -183,7 +185,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="in-plane cell sizes [a]")
     ap.add_argument("--levels", nargs="+", default=["coarse"],
                     help="levels whose wall layers and capillary safety are used")
-    ap.add_argument("--film", type=float, default=4e-6,
+    ap.add_argument("--film", type=float, default=FILM,
                     help="oil carried in, as a film thickness at the rolling speed [m]")
     ap.add_argument("--x-in", type=float, default=X_IN, help="supply at x = X a")
     ap.add_argument("--x-out", type=float, default=X_OUT, help="outlet at x = X a")

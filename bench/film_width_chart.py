@@ -27,6 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import RESULTS  # noqa: E402
 from bench.fill_extrapolation import analyse  # noqa: E402
+from bench.film_deposition import FILM  # noqa: E402
 from generator.case_spec import CaseSpec, Mesh  # noqa: E402
 from generator.case_writer import load_spec_of, size_function  # noqa: E402
 
@@ -55,7 +56,10 @@ def strip_table() -> dict[Series, dict[float, dict]]:
     left out)."""
     table: dict[Series, dict[float, dict]] = defaultdict(dict)
     for path in sorted(RESULTS.glob("film_deposition*.json")):
-        for row in json.loads(path.read_text())["rows"]:
+        record = json.loads(path.read_text())
+        if float(record["args"].get("film", FILM)) != FILM:
+            continue    # fed at another rate: its meniscus sits at another gap
+        for row in record["rows"]:
             other = set(row.get("options", {})) - MESH_OPTIONS - SCHEME_OPTIONS
             if row["status"] != "ok" or other:   # the nominal physics only
                 continue

@@ -9,6 +9,12 @@ where the mid-gap is air (alpha < 0.05): behind the region (x > 8 a, |y| < 4 a) 
 it (|y| > 6 a), and the oil fraction of the wall cells of the disc and of the ball there
 (medians over those columns).
 
+The films keep the thickness they were laid with while the gap behind the meniscus grows, so
+the oil over the local gap falls short of LL by h(meniscus) / h(x): read it against LL only
+where the region behind is short (the default domains: the rear meniscus 1.4-5 a from the
+outlet); with the outlet at 20 a and the rear at 13.7 a the median column sits where the gap
+is some 1.5 times the meniscus's (docs/cases.md, "What the films converge to").
+
     python bench/wall_films.py CASE [CASE ...] [--save NAME.json]
 """
 from __future__ import annotations
