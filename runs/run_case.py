@@ -37,8 +37,9 @@ import numpy as np
 from foamlib import FoamFile
 
 from ehl_precalc.outputs import atomic_write_json, atomic_write_text
+from generator.case_spec import CaseSpec
 from generator.case_writer import (META, CaseGeometry, load_geometry, load_spec_of,
-                                   mesh_warnings)
+                                   mesh_warnings, size_function)
 
 from . import case_fields
 from .foam_runtime import FoamRuntime
@@ -56,6 +57,11 @@ OFF_OUTLET_WARNING = 0.05
 #: films the rear meniscus lays (a film-resolving run's rear reached 13.5 a against a 14 a
 #: outlet, docs/cases.md "What the films converge to")
 CLEARANCE_WARNING = 1.0
+#: in-plane cells at the rear meniscus coarser than this (units a) are flagged: they lay wall
+#: films thicker than Landau-Levich's (1.6-2.1 times at 0.55 a, 1.0 at 0.1 a on the 2D strip),
+#: and the flooded width comes out short (the default levels' 0.5 a cells by 16-20 % against
+#: a run at 0.1 a; docs/cases.md, "What the films converge to")
+REAR_CELL_WARNING = 0.15
 
 
 class CaseBusy(RuntimeError):
@@ -473,10 +479,36 @@ def boundary_warnings(off_outlet: float | None, pattern: dict | None = None) -> 
     return out
 
 
+def rear_meniscus_cell(spec: CaseSpec, pattern: dict | None) -> float | None:
+    """In-plane cell size (units a) where the closed flooded region's rear meniscus crosses
+    y = 0 (at ``flooded_x_max_over_a``): the cells that lay the wall films leaving the region,
+    which decide how much oil it holds and how wide it grows. None for an open wake (state II)
+    or no region."""
+    x_rear = (pattern or {}).get("flooded_x_max_over_a")
+    if x_rear is None or pattern.get("state") != "I":
+        return None
+    return float(size_function(spec)(x_rear * spec.a, 0.0) / spec.a)
+
+
+def rear_cell_warnings(rear_cell: float | None) -> list[str]:
+    """A warning when the rear meniscus sits in cells (``rear_cell``, units a) coarser than
+    :data:`REAR_CELL_WARNING`, naming what refines them."""
+    if rear_cell is None or rear_cell <= REAR_CELL_WARNING:
+        return []
+    return [f"the rear meniscus sits in {rear_cell:.2f} a cells (above {REAR_CELL_WARNING:g} a): "
+            f"they lay wall films thicker than Landau-Levich's and the flooded width comes out "
+            f"short (the default levels' by 16-20 %); refine over the rear (mesh.refine, as in "
+            f"runs/nominal_films.toml); docs/cases.md, \"What the films converge to\""]
+
+
 def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, tail, wall, case) -> dict:
     last = history[-1] if history else None
     pattern = dict(last.pattern) if last else {}
     off_outlet = case_fields.off_outlet_share(last.oil_out_by_boundary) if last else None
+    # where oil fills the domain (single-phase scene, submerged supply) it meets every
+    # boundary by design and lays no films: these warnings are for a region surrounded by air
+    surrounded = geom.open_inflow_oil == 0.0
+    rear_cell = rear_meniscus_cell(spec, pattern) if surrounded else None
     out = {
         "status": "failed" if failed else ("interrupted" if reason == "interrupted" else "finished"),
         "end_reason": reason,
@@ -506,10 +538,9 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "speed_m_s": geom.speed,
         "mesh_gap_mismatch": geom.gap_mismatch,
         "ball_wall_steps": geom.ball_wall_steps,
-        # where oil fills the domain (single-phase scene, submerged supply) it meets every
-        # boundary by design: the boundary warnings are for a region surrounded by air
-        "warnings": "; ".join(mesh_warnings(geom) + (
-            boundary_warnings(off_outlet, pattern) if geom.open_inflow_oil == 0.0 else [])),
+        "rear_meniscus_cell_over_a": rear_cell,
+        "warnings": "; ".join(mesh_warnings(geom) + rear_cell_warnings(rear_cell) + (
+            boundary_warnings(off_outlet, pattern) if surrounded else [])),
     }
     if failed:
         log = case / geom.log_name

@@ -3,13 +3,17 @@ synthetic histories and fields."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from generator.case_writer import CaseGeometry
 from runs.case_fields import Sample, gas_dissolution, gas_release, smeared_oil_fraction
-from runs.run_case import (CLEARANCE_WARNING, OFF_OUTLET_WARNING, boundary_warnings,
-                           dissolved_air_budget, mass_balance, steady_test)
+from generator.case_spec import load_case_spec
+from runs.run_case import (CLEARANCE_WARNING, OFF_OUTLET_WARNING, REAR_CELL_WARNING,
+                           boundary_warnings, dissolved_air_budget, mass_balance,
+                           rear_cell_warnings, rear_meniscus_cell, steady_test)
 
 
 def history(volumes, menisci, dt=0.01, state="I"):
@@ -189,3 +193,26 @@ def test_a_region_near_an_open_boundary_is_flagged():
     # both at once: spilled over the side and still touching it
     assert len(boundary_warnings(0.55, {"flooded_clearance_over_a": 0.0,
                                         "flooded_nearest_boundary": "side"})) == 2
+
+
+def test_the_cells_at_the_rear_meniscus_are_read_off_the_spec_and_coarse_ones_flagged():
+    """The default medium level's rear meniscus (11 a behind the contact on y = 0) sits in its
+    far-field cells; runs/nominal_films.toml's box puts 0.1 a cells there; an open wake has no
+    rear meniscus."""
+    root = Path(__file__).resolve().parent.parent / "runs"
+    nominal, films = (load_case_spec(root / n) for n in ("nominal.toml", "nominal_films.toml"))
+    closed = {"state": "I", "flooded_x_max_over_a": 11.0}
+    far = rear_meniscus_cell(nominal, closed)
+    assert far == pytest.approx(nominal.mesh.level()["size_far"])
+    assert rear_meniscus_cell(films, closed) == pytest.approx(0.1)
+    # nearer the contact the cells shrink with the distance from it, below the far size
+    assert rear_meniscus_cell(nominal, {**closed, "flooded_x_max_over_a": 3.0}) < far
+    assert rear_meniscus_cell(nominal, {**closed, "state": "II"}) is None
+    assert rear_meniscus_cell(nominal, {"state": "I", "flooded_x_max_over_a": None}) is None
+    assert rear_meniscus_cell(nominal, None) is None
+    [warning] = rear_cell_warnings(far)
+    assert warning.startswith(f"the rear meniscus sits in {far:.2f} a cells")
+    assert "mesh.refine" in warning and "nominal_films.toml" in warning
+    assert rear_cell_warnings(0.1) == []
+    assert rear_cell_warnings(REAR_CELL_WARNING) == []
+    assert rear_cell_warnings(None) == []
