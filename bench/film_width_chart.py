@@ -29,7 +29,8 @@ from bench.common import RESULTS  # noqa: E402
 from bench.fill_extrapolation import analyse  # noqa: E402
 from bench.film_deposition import FILM  # noqa: E402
 from generator.case_spec import CaseSpec, Mesh  # noqa: E402
-from generator.case_writer import load_spec_of, size_function  # noqa: E402
+from generator.case_writer import load_spec_of  # noqa: E402
+from runs.run_case import rear_meniscus_cell  # noqa: E402
 
 
 #: a run still filling (or draining) faster than this (share of the inflow kept) is too far
@@ -85,7 +86,7 @@ def rear_cell_size(spec: CaseSpec, last: dict) -> float:
     """The in-plane cell size (a) where the case's rear meniscus crosses y = 0 over its last
     transit: size_far, or a refinement box's cells there."""
     x_rear = -1.0 - last["inlet_meniscus_distance_over_a"] + last["flooded_length_over_a"]
-    return float(size_function(spec)(x_rear * spec.a, 0.0) / spec.a)
+    return rear_meniscus_cell(spec, {"state": "I", "flooded_x_max_over_a": x_rear})
 
 
 def case_point(case: Path, table: dict, n_fit: int) -> dict:
