@@ -58,6 +58,8 @@ def main(argv=None) -> int:
         ax.add_patch(plt.Circle((0, 0), g.island_radius / g.a, color="k"))
         ax.add_patch(plt.Circle((0, 0), 1.0, color="r", fill=False, lw=1))
         m = _metrics_at(case, None if at is None else t)
+        if m.get("status") == "running":   # a run in progress: its last sampled write
+            m = _metrics_at(case, t)
         spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
         sup = spec["supply"]
         supply = (f"layers {sup['disc_layer'] * 1e6:g}+{sup['ball_layer'] * 1e6:g} um"
