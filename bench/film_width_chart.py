@@ -170,7 +170,8 @@ def main(argv: list[str] | None = None) -> int:
         if p["width_balance"]:
             right.plot([p["f_over_ll"]] * 2, [min(p["width_balance"]), max(p["width_balance"])],
                        "r_-", ms=10)
-        right.annotate(f"{Path(p['case']).name} {p['rear_dx']:.2g} a", (p["f_over_ll"],
+        right.annotate(f"{Path(p['case']).name} {p['rear_dx']:.2g} a, {p['layers'][0]} layers",
+                       (p["f_over_ll"],
                        p["width_last"]), fontsize=7, xytext=(4, -10), textcoords="offset points")
     right.axvline(1.0, color="k", lw=0.8)
     right.set_xlabel("films laid by the case's rear cells / Landau-Levich (strip)")
