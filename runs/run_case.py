@@ -59,8 +59,9 @@ OFF_OUTLET_WARNING = 0.05
 CLEARANCE_WARNING = 1.0
 #: in-plane cells at the rear meniscus coarser than this (units a) are flagged: they lay wall
 #: films thicker than Landau-Levich's (1.6-2.1 times at 0.55 a, 1.0 at 0.1 a on the 2D strip),
-#: and the flooded width comes out short (the default levels' 0.5 a cells by 16-20 % against
-#: a run at 0.1 a; docs/cases.md, "What the films converge to")
+#: and the flooded width comes out short (the default levels' 0.4-0.8 a cells by 16-20 %
+#: against a run at 0.1 a, 11-16 % against one at 0.05 a on the rear arc; docs/cases.md, "One
+#: step finer at the rear meniscus")
 REAR_CELL_WARNING = 0.15
 
 
@@ -497,8 +498,9 @@ def rear_cell_warnings(rear_cell: float | None) -> list[str]:
         return []
     return [f"the rear meniscus sits in {rear_cell:.2f} a cells (above {REAR_CELL_WARNING:g} a): "
             f"they lay wall films thicker than Landau-Levich's and the flooded width comes out "
-            f"short (the default levels' by 16-20 %); refine over the rear (mesh.refine, as in "
-            f"runs/nominal_films.toml); docs/cases.md, \"What the films converge to\""]
+            f"short (the default levels' by 11-20 % against the finest runs); refine over the rear "
+            f"(mesh.refine, as in runs/nominal_films.toml); docs/cases.md, \"One step finer at "
+            f"the rear meniscus\""]
 
 
 def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, tail, wall, case) -> dict:

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from generator.case_spec import load_case_spec
 from generator.case_writer import CaseGeometry
 from runs.case_fields import Sample, gas_dissolution, gas_release, smeared_oil_fraction
-from generator.case_spec import load_case_spec
 from runs.run_case import (CLEARANCE_WARNING, OFF_OUTLET_WARNING, REAR_CELL_WARNING,
                            boundary_warnings, dissolved_air_budget, mass_balance,
                            rear_cell_warnings, rear_meniscus_cell, steady_test)
