@@ -50,9 +50,13 @@ def solve_in_subprocess(spec_kwargs: dict, options: dict | None = None) -> dict:
 
 
 def save(name: str, data) -> Path:
+    """Write a record ``bench/results/NAME`` as JSON, atomically (an interrupted script never
+    leaves half a record)."""
+    from ehl_precalc.outputs import atomic_write_text
+
     RESULTS.mkdir(exist_ok=True)
     path = RESULTS / name
-    path.write_text(json.dumps(data, indent=2, default=str) + "\n")
+    atomic_write_text(path, json.dumps(data, indent=2, default=str) + "\n")
     return path
 
 

@@ -1,0 +1,64 @@
+"""bench/mesh_convergence.py's observed order and grid convergence index (Celik et al. 2008) on
+metrics with a known limit: f(h) = f0 + C h^p."""
+
+from __future__ import annotations
+
+import pytest
+
+from bench.mesh_convergence import observed_order
+
+
+@pytest.mark.parametrize("sizes", [(0.2, 0.1, 0.05), (0.8, 0.55, 0.38), (0.05, 0.2, 0.1)])
+@pytest.mark.parametrize("p", [1.0, 2.0, 0.6])
+def test_a_power_law_gives_its_order_and_its_limit(sizes, p):
+    f = tuple(14.0 + 3.0 * h ** p for h in sizes)
+    o = observed_order(sizes, f)
+    assert o["behaviour"] == "monotone"
+    assert 0 < o["R"] < 1
+    assert o["order"] == pytest.approx(p, rel=1e-6)
+    assert o["extrapolated"] == pytest.approx(14.0, rel=1e-6)
+    assert o["asymptotic"] is (0.5 <= p <= 3.0)
+    assert o["sizes"] == sorted(sizes)                       # index 1 is the finest
+    f1 = 14.0 + 3.0 * min(sizes) ** p
+    assert o["error_fine"] == pytest.approx((f1 - 14.0) / 14.0, rel=1e-6)
+    assert o["gci_fine"] == pytest.approx(1.25 * (f1 - 14.0) / f1, rel=1e-6)
+
+
+def test_alternating_changes_that_shrink_are_oscillatory_convergence():
+    o = observed_order((0.4, 0.2, 0.1), (12.0, 14.0, 13.5))    # +2, then -0.5
+    assert o["behaviour"] == "oscillatory"
+    assert o["R"] == pytest.approx(-0.25)
+    assert o["order"] == pytest.approx(2.0)
+    assert o["extrapolated"] == pytest.approx((4 * 13.5 - 14.0) / 3)    # beyond f1, as the sign flips
+
+
+@pytest.mark.parametrize("f", [(15.66, 14.59, 13.0), (11.5, 13.7, 16.7)])
+def test_changes_that_do_not_shrink_are_divergent_and_get_no_extrapolation(f):
+    o = observed_order((0.2, 0.1, 0.05), f)
+    assert o["behaviour"] == "divergent"
+    assert abs(o["R"]) >= 1
+    assert "extrapolated" not in o and "gci_fine" not in o
+
+
+def test_changes_inside_the_jitter_say_nothing_about_the_order():
+    f = (6.64, 6.57, 6.45)
+    assert observed_order((0.8, 0.55, 0.38), f)["behaviour"] == "divergent"
+    o = observed_order((0.8, 0.55, 0.38), f, noise=0.27)
+    assert o["behaviour"] == "within noise"
+    assert o["spread"] == pytest.approx(0.19)
+    assert "order" not in o
+
+
+def test_sizes_must_be_three_different_positive_values():
+    with pytest.raises(ValueError, match="sizes"):
+        observed_order((0.1, 0.1, 0.05), (1.0, 2.0, 3.0))
+    with pytest.raises(ValueError, match="sizes"):
+        observed_order((0.0, 0.1, 0.05), (1.0, 2.0, 3.0))
+
+
+def test_an_order_far_from_the_schemes_is_flagged_not_asymptotic():
+    o = observed_order((0.2, 0.1, 0.05), (15.57, 14.59, 13.71))   # changes 0.98, 0.88
+    assert o["behaviour"] == "monotone"
+    assert o["order"] == pytest.approx(0.155, abs=0.005)
+    assert o["asymptotic"] is False
+    assert observed_order((0.2, 0.1, 0.05), (14.4, 14.1, 14.025))["asymptotic"] is True
