@@ -839,3 +839,33 @@ def test_single_phase_case_stays_oil(tmp_path):
     assert "boundary" not in m["warnings"], m["warnings"]
     # and lays no films at a rear meniscus
     assert m["rear_meniscus_cell_over_a"] is None and "rear meniscus" not in m["warnings"]
+
+
+def test_meniscus_pressure_reads_a_known_jump_off_written_fields(small_case, tmp_path):
+    """bench/meniscus_pressure.py on fields written by hand: oil inside r = 3 a at Young-
+    Laplace's suction for the gap there, air at 0 outside. It finds the meniscus within a cell
+    on every ray and the jump within the gap's change over a cell."""
+    from bench.meniscus_pressure import along_rays
+
+    case = _copy(small_case, tmp_path)
+    geom = load_geometry(case)
+    centres = np.load(case / "ehlfoam" / "mesh.npz")["cell_centres"]
+    r_m = 3.0 * geom.a
+    oil = np.hypot(centres[:, 0], centres[:, 1]) < r_m
+    from ehl_precalc.gap import GapField
+    h = float(GapField.load(case / "precalc")(r_m, 0.0))
+    suction = 2 * 0.030 * np.cos(np.radians(15.0)) / h            # the spec's defaults
+    folder = case / "0.001"
+    folder.mkdir()
+    for name, values in (("alpha.oil", oil.astype(float)), ("p", np.where(oil, -suction, 0.0))):
+        shutil.copy(case / "0.orig" / ("alpha.oil" if name == "alpha.oil" else "p_rgh"),
+                    folder / name)
+        FoamFieldFile(folder / name).internal_field = values
+    res = along_rays(case, angles=(0, 60, 120, 180), inside=1.0, outside=1.0)
+    assert res["time_s"] == pytest.approx(1e-3)
+    for ray in res["rays"]:
+        cell = ray["cell_over_a"]
+        assert ray["meniscus_over_a"] == pytest.approx(3.0, abs=1.5 * cell), ray
+        assert ray["jump_Pa"] == pytest.approx(suction, rel=1e-6), ray
+        # the reference is read at the meniscus found: within a cell of r = 3 a
+        assert ray["jump_over_laplace"] == pytest.approx(1.0, abs=2 * 1.5 * cell / 3.0), ray
