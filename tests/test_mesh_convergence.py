@@ -1,11 +1,11 @@
-"""bench/mesh_convergence.py's observed order and grid convergence index (Celik et al. 2008) on
+"""runs/convergence.py: the observed order and grid convergence index (Celik et al. 2008) on
 metrics with a known limit: f(h) = f0 + C h^p."""
 
 from __future__ import annotations
 
 import pytest
 
-from bench.mesh_convergence import observed_order
+from runs.convergence import observed_order
 
 
 @pytest.mark.parametrize("sizes", [(0.2, 0.1, 0.05), (0.8, 0.55, 0.38), (0.05, 0.2, 0.1)])

@@ -354,3 +354,56 @@ def test_browser_check_sees_a_missing_image(case_report, tmp_path):
     finally:
         broken.unlink()
     assert loaded == total - 1
+
+
+def test_batch_report_reads_the_mesh_convergence_of_three_levels(finished_case, case_report,
+                                                                  tmp_path):
+    """Three copies of a real case, filed as coarse / medium / fine with far-field cells of
+    0.8 / 0.55 / 0.38 a, their histories rewritten: a width that follows 12 + 3 h^2 reads as
+    converging at order 2 towards 12 a; an inlet meniscus whose level means differ by less
+    than its own jitter reads as within noise. A fourth case at another speed is left out."""
+    from runs.report.batch import convergence_groups
+
+    root = tmp_path / "conv"
+    sizes = {"coarse": 0.8, "medium": 0.55, "fine": 0.38}
+    inlet = {"coarse": 6.64, "medium": 6.57, "fine": 6.45}
+    rows = []
+    for level, h in sizes.items():
+        case = _copy(finished_case, root / "cases" / level)
+        spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
+        spec["mesh"]["size_far"] = h
+        (case / "ehlfoam" / "spec.json").write_text(json.dumps(spec))
+        with open(case / "history.csv", newline="") as fh:
+            hist = list(csv.DictReader(fh))
+        for i, r in enumerate(hist):
+            r["flooded_width_over_a"] = 12.0 + 3.0 * h ** 2
+            r["inlet_meniscus_distance_over_a"] = inlet[level] + (0.2 if i % 2 else -0.2)
+        with open(case / "history.csv", "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(hist[0]))
+            w.writeheader()
+            w.writerows(hist)
+        rows.append({"case_id": level, "speed_mm_s": 20, "temperature_C": 40, "load_N": 20,
+                     "supply": "layers", "disc_layer_um": 3, "ball_layer_um": 3,
+                     "resolution": level, "status": "finished", "case_dir": f"cases/{level}"})
+    _copy(finished_case, root / "cases" / "other")
+    rows.append({**rows[0], "case_id": "other", "speed_mm_s": 40, "case_dir": "cases/other"})
+    with open(root / "results.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    # no case report to remake: the copies keep theirs, made after their results
+    for level in [*sizes, "other"]:
+        shutil.copytree(finished_case / "report", root / "cases" / level / "report",
+                        dirs_exist_ok=True)
+        for f in (root / "cases" / level / "report").iterdir():
+            os.utime(f)
+
+    read = report_batch(root, jobs=1, animate=False)
+    groups = convergence_groups(
+        [{**r, "_folder": root / r["case_dir"]} for r in rows])
+    assert [[p.name for p in folders] for _, folders in groups] == [["coarse", "medium", "fine"]]
+    html = read.read_text()
+    assert "Mesh convergence over the three levels" in html
+    assert "monotone, order 2.00: extrapolated 12 a" in html
+    assert "within noise" in html
+    assert json.loads((read.parent / "report.json").read_text())["case_reports_made"] == 0

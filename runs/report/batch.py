@@ -6,7 +6,8 @@ folder and log relative to the batch), ``cases/<id>/`` and ``regime/`` (regime m
 ``regime.json``). Every part is optional; a missing column or file leaves its part out.
 
 The page: counts, the regime pictures, bubble length against speed per temperature with the
-thesis's relation fitted, the flow states over the batch's parameters, an index of the cases
+thesis's relation fitted, the flow states over the batch's parameters, the mesh convergence of
+the cases run on all three resolution levels (runs/convergence.py), an index of the cases
 with thumbnails (each linking to its case report) and the failures with their reason and
 log. Case reports are made (in parallel) only where none is newer than the case's results;
 an up-to-date report's thumbnail is reused.
@@ -24,6 +25,7 @@ from pathlib import Path
 
 from ehl_precalc.outputs import atomic_write_json
 
+from .. import convergence
 from . import units
 from .case_data import load_geometry_tolerant, tail_lines
 from .case_report import REPORT, report_case
@@ -362,6 +364,70 @@ def _find_log(folder: Path) -> Path | None:
     return find_log(folder, load_geometry_tolerant(folder, []))
 
 
+#: The resolution levels, coarsest first, that a mesh convergence reading needs all of.
+LEVELS = ("coarse", "medium", "fine")
+#: Parameters that tell the cases of one convergence group apart from another's.
+GROUP_KEYS = ("speed_mm_s", "temperature_C", "load_N", "supply", "disc_layer_um",
+              "ball_layer_um")
+
+
+def convergence_groups(rows: list[dict]) -> list[tuple[dict, list[Path]]]:
+    """Finished cases that differ only in their resolution level and cover all three:
+    (the shared parameters, the case folders coarse, medium, fine) per group."""
+    groups: dict[tuple, dict[str, Path]] = {}
+    for r in rows:
+        if r.get("status") != "finished" or r.get("_folder") is None \
+                or r.get("resolution") not in LEVELS:
+            continue
+        key = tuple((k, r.get(k)) for k in GROUP_KEYS)
+        groups.setdefault(key, {})[r["resolution"]] = r["_folder"]
+    return [(dict(key), [levels[lv] for lv in LEVELS]) for key, levels in groups.items()
+            if all(lv in levels for lv in LEVELS)]
+
+
+def reading_text(o: dict, unit: units.Unit) -> str:
+    """One line for a metric's convergence reading (:func:`runs.convergence.observed_order`)."""
+    if o["behaviour"] == "within noise":
+        return (f"within noise: the spread {units.display(o['spread'], unit)} {unit[1]} is no "
+                f"more than twice the jitter of its last transit")
+    if o["behaviour"] == "divergent":
+        r = "" if o.get("R") is None else f" (R = {o['R']:+.2g})"
+        return f"divergent: the changes do not shrink{r}; no extrapolation"
+    if o.get("order") is None:
+        return f"{o['behaviour']}: no change on the two finest"
+    text = (f"{o['behaviour']}, order {o['order']:.2f}: extrapolated "
+            f"{units.display(o['extrapolated'], unit)} {unit[1]}, GCI of the fine level "
+            f"{100 * o['gci_fine']:.2g} %")
+    if not o["asymptotic"]:
+        text += " (order outside 0.5-3: not asymptotic, not to be trusted)"
+    return text
+
+
+def _convergence_table(rows: list[dict]) -> Table | None:
+    """Per group of cases run on all three levels: each metric's values and reading."""
+    body = []
+    for params, folders in convergence_groups(rows):
+        try:
+            readings = convergence.over_cases(folders)
+        except (OSError, ValueError, KeyError):
+            continue
+        label = ", ".join(f"{PARAMETERS[k][0]} {_f(v)}" if k in PARAMETERS else f"{k} {v}"
+                          for k, v in params.items() if v is not None)
+        for key, o in readings.items():
+            unit = units.METRICS[key]
+            body.append([label, unit[0] + (f" [{unit[1]}]" if unit[1] else ""),
+                         *(cell(units.display(v, unit), num=True) for v in o["values"][::-1]),
+                         reading_text(o, unit)])
+    if not body:
+        return None
+    return Table("Mesh convergence over the three levels",
+                 ["cases", "metric", "coarse", "medium", "fine", "reading"], body,
+                 note="Each metric's mean over its case's last transit; the reading is Celik "
+                      "et al. 2008 (J. Fluids Eng. 130, 078001) with the levels' far-field "
+                      "cell sizes: observed order, Richardson extrapolation and the fine "
+                      "level's grid convergence index (runs/convergence.py).")
+
+
 def _regime(batch: Path, out: Path, page: Page) -> None:
     regime = batch / "regime"
     if not regime.is_dir():
@@ -450,6 +516,9 @@ def _report_batch(batch: Path, jobs: int | None, animate: bool, force: bool) -> 
                                        "each case over the parameters the batch varies."))
     except Exception as exc:  # noqa: BLE001 - the page still lists the cases
         problems.append(f"batch charts: {type(exc).__name__}: {exc}")
+    conv = _convergence_table(rows)
+    if conv is not None:
+        page.tables.append(conv)
     failures = _failures_table(rows, batch, out, errors)
     if failures:
         page.lead_tables.append(failures)

@@ -1,0 +1,149 @@
+"""Mesh convergence of a case's flow pattern over three meshes: the observed order, the
+Richardson extrapolation and the grid convergence index (GCI) of Celik et al. 2008
+(J. Fluids Eng. 130, 078001, the journal's procedure for discretisation uncertainty).
+
+With h1 < h2 < h3 (index 1 the finest) and the changes e21 = f2 - f1, e32 = f3 - f2, R = e21 /
+e32 says how a metric behaves: 0 < R < 1 monotone convergence (the changes shrink), -1 < R < 0
+oscillatory convergence, |R| >= 1 divergence (no extrapolation, no index). For a converging
+metric the order p solves p ln r21 = |ln|e32 / e21| + ln((r21^p - s) / (r32^p - s))| (s =
+sign(e32 / e21)), the extrapolated value is (r21^p f1 - f2) / (r21^p - 1) and the fine mesh's
+index GCI = 1.25 |e21 / f1| / (r21^p - 1). Two readings guard it: changes no bigger than the
+metric's own jitter (twice the standard deviation of its last writes) say nothing ("within
+noise"), and an order outside :data:`ASYMPTOTIC_ORDER` says the meshes are not in the
+asymptotic range, where neither the extrapolation nor the index holds.
+
+Used by the batch report (a batch that sweeps ``resolution``) and ``bench/mesh_convergence.py``.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+
+from generator.case_writer import load_geometry, load_spec_of
+
+#: The flow-pattern metrics read over the meshes (metrics.json / history.csv keys).
+METRICS = ("inlet_meniscus_distance_over_a", "flooded_width_over_a", "flooded_length_over_a",
+           "oil_volume_m3")
+SAFETY = 1.25   # Celik et al.'s factor of safety for three meshes
+#: Observed orders outside this range say the meshes are not in the asymptotic range (the
+#: schemes are of order 1-2): the extrapolation and the index are then not to be trusted.
+ASYMPTOTIC_ORDER = (0.5, 3.0)
+
+
+def observed_order(h: tuple[float, float, float], f: tuple[float, float, float],
+                   noise: float = 0.0, tol: float = 1e-10, max_iter: int = 200) -> dict:
+    """Observed order, Richardson extrapolation and grid convergence index of a metric ``f``
+    on three meshes of representative cell sizes ``h`` (any order, any one unit).
+
+    Returns ``behaviour`` ("monotone", "oscillatory", "divergent", "unchanged", or "within
+    noise" where both changes are at most ``noise``, the metric's own jitter in the units of
+    ``f``: then the changes say nothing about the order) and ``R = e21 / e32``; for a
+    converging metric also ``order`` p, ``extrapolated`` (the Richardson value),
+    ``gci_fine`` (the fine mesh's relative uncertainty band, with safety factor 1.25),
+    ``error_fine`` (|f1 - f_ext| / |f_ext|) and ``asymptotic`` (p within
+    :data:`ASYMPTOTIC_ORDER`: otherwise neither the extrapolation nor the index holds).
+    Index 1 is the finest. Raises ValueError unless the sizes are three different positive
+    values.
+    """
+    (h1, f1), (h2, f2), (h3, f3) = sorted(zip(h, f))
+    if not (0 < h1 < h2 < h3):
+        raise ValueError(f"sizes: need three different positive cell sizes, got {h}")
+    r21, r32 = h2 / h1, h3 / h2
+    e21, e32 = f2 - f1, f3 - f2
+    out: dict = {"sizes": [h1, h2, h3], "values": [f1, f2, f3], "r21": r21, "r32": r32}
+    if max(abs(e21), abs(e32)) <= noise:
+        return out | {"behaviour": "within noise", "R": e21 / e32 if e32 else None,
+                      "spread": max(f) - min(f)}
+    if e21 == 0.0 and e32 == 0.0:
+        return out | {"behaviour": "unchanged", "R": None, "order": None,
+                      "extrapolated": f1, "gci_fine": 0.0, "error_fine": 0.0}
+    if e32 == 0.0:
+        return out | {"behaviour": "divergent", "R": None}
+    R = e21 / e32
+    out["R"] = R
+    if abs(R) >= 1.0:
+        return out | {"behaviour": "divergent"}
+    if e21 == 0.0:   # converged on the two finest: no order to read
+        return out | {"behaviour": "monotone", "order": None, "extrapolated": f1,
+                      "gci_fine": 0.0, "error_fine": 0.0}
+    s = math.copysign(1.0, e32 / e21)
+    p = abs(math.log(abs(e32 / e21))) / math.log(r21)
+    for _ in range(max_iter):
+        q = math.log((r21 ** p - s) / (r32 ** p - s))
+        p_new = abs(math.log(abs(e32 / e21)) + q) / math.log(r21)
+        if abs(p_new - p) < tol:
+            p = p_new
+            break
+        p = p_new
+    ext = (r21 ** p * f1 - f2) / (r21 ** p - 1.0)
+    lo, hi = ASYMPTOTIC_ORDER
+    return out | {"behaviour": "monotone" if R > 0 else "oscillatory", "order": p,
+                  "asymptotic": lo <= p <= hi, "extrapolated": ext,
+                  "gci_fine": SAFETY * abs(e21 / f1) / (r21 ** p - 1.0),
+                  "error_fine": abs((f1 - ext) / ext) if ext else None}
+
+
+def jitter(rows: list[dict]) -> dict[str, float]:
+    """Per metric, the standard deviation over history.csv ``rows`` (0 for fewer than two
+    values)."""
+    out = {}
+    for k in METRICS:
+        vals = np.array([float(r[k]) for r in rows if r.get(k) not in (None, "", "None")])
+        out[k] = float(vals.std()) if vals.size > 1 else 0.0
+    return out
+
+
+def read_history_rows(case: Path) -> list[dict]:
+    """The case's history.csv as dicts of strings (empty without one)."""
+    path = Path(case) / "history.csv"
+    if not path.is_file():
+        return []
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def last_transit(case: Path) -> dict | None:
+    """The case's last state: each metric's mean over the last transit of its history.csv
+    (one write alone carries the meniscus's cell-to-cell jitter), that jitter, the time [s]
+    and the state of the last write; None without a history."""
+    rows = read_history_rows(case)
+    if not rows:
+        return None
+    t_end = float(rows[-1]["time_s"])
+    last = [r for r in rows if float(r["time_s"]) >= t_end - load_geometry(case).transit_time]
+    means = {}
+    for k in METRICS:
+        vals = [float(r[k]) for r in last if r.get(k) not in (None, "", "None")]
+        means[k] = sum(vals) / len(vals) if vals else None
+    return means | {"time_s": t_end, "state": rows[-1]["state"], "writes_averaged": len(last),
+                    "jitter": jitter(last)}
+
+
+def level_size(case: Path) -> float:
+    """The in-plane cell size far from the contact (units of a) a case's mesh was built with:
+    the level's ``size_far`` with the spec's overrides, where the menisci sit. The levels
+    scale every size by the same ratio, so it stands for the whole mesh."""
+    return float(load_spec_of(case).mesh.level()["size_far"])
+
+
+def over_cases(cases: list[Path], sizes: list[float] | None = None) -> dict:
+    """observed_order of every metric over three cases at their last transit; ``sizes``
+    default to :func:`level_size`. The noise is twice the largest jitter of the three."""
+    if len(cases) != 3:
+        raise ValueError(f"cases: need three, got {len(cases)}")
+    states = [last_transit(c) for c in cases]
+    if any(s is None for s in states):
+        raise ValueError("cases: each needs a history.csv")
+    sizes = list(sizes) if sizes is not None else [level_size(c) for c in cases]
+    out = {}
+    for k in METRICS:
+        vals = [s[k] for s in states]
+        if None in vals:
+            continue
+        noise = 2 * max(s["jitter"][k] for s in states)
+        out[k] = observed_order(tuple(sizes), tuple(vals), noise=noise)
+    return out
