@@ -41,7 +41,7 @@ sys.path.insert(0, str(ROOT))
 from foamlib import FoamFieldFile  # noqa: E402
 
 from bench.common import save, spec_option  # noqa: E402
-from bench.wall_films import landau_levich  # noqa: E402
+from ehl_precalc.meniscus_reynolds import landau_levich  # noqa: E402
 from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
 from generator.case_writer import (TEMPLATES, capillary_time_step,  # noqa: E402
                                    edit_physics_dicts, edit_run_control)

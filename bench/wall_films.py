@@ -28,18 +28,13 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
+from ehl_precalc.meniscus_reynolds import landau_levich  # noqa: E402
 from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
 from generator.mesh import layer_fractions  # noqa: E402
 from runs import case_fields  # noqa: E402
 
 #: where the films are read, in units of a: (name, x > ..., |y| < ..., |y| > ...)
 REGIONS = (("behind", 8.0, 4.0, 0.0), ("beside", -np.inf, np.inf, 6.0))
-
-
-def landau_levich(eta: float, u: float, sigma: float) -> float:
-    """Both walls' films over the gap [-] behind a receding meniscus (r = h / 2)."""
-    c = (eta * u / sigma) ** (2.0 / 3.0)
-    return 2.0 * 1.34 * c * 0.5 / (1.0 + 3.35 * c)
 
 
 def films(case: Path) -> dict:

@@ -1,0 +1,123 @@
+"""The thin-film model of the flooded region (ehl_precalc.meniscus_reynolds): a strip against
+its 1D theory, a region round an island, films, metrics and bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from ehl_precalc.meniscus_reynolds import (Grid, ThinFilmProblem, landau_levich,
+                                           region_metrics, solve_thin_film)
+
+ETA, U, SIGMA, THETA = 0.02, 0.01, 0.03, 15.0
+
+
+def strip_gap(x, y):
+    """A gap that does not vary along y: 20 um at x = 0, a 10 mm radius."""
+    return 20e-6 + np.asarray(x) ** 2 / (2 * 0.01) + 0 * np.asarray(y)
+
+
+def test_strip_menisci_sit_where_the_1d_theory_puts_them():
+    """In a strip the steady region passes the supply s as Landau-Levich films: its rear
+    meniscus sits where f h = s, and its inlet meniscus where the Reynolds pressure rise
+    from it to the rear, int 12 eta u (h - s) / h^3 dx, equals the capillary pressures'
+    difference 2 sigma cos(theta) (1 / h_in - 1 / h_rear)."""
+    s, cell = 4e-6, 2.5e-5
+    prob = ThinFilmProblem(gap=strip_gap, speed=U, viscosity=ETA, surface_tension=SIGMA,
+                           contact_angle=THETA, supply=s, track_half_width=1.0,
+                           x_range=(-2e-3, 3e-3), y_max=2 * cell, island_radius=0.0,
+                           cell=cell, initial_radius=0.8e-3, closed_side=True)
+    sol = solve_thin_film(prob, transits_max=10, tolerance=0.0, transit_length=5e-3)
+    h_rear = s / landau_levich(ETA, U, SIGMA)
+    x_rear = np.sqrt(2 * 0.01 * (h_rear - 20e-6))
+    cos_t = np.cos(np.radians(THETA))
+
+    def mismatch(x_in):
+        rise = quad(lambda x: 12 * ETA * U * (strip_gap(x, 0) - s) / strip_gap(x, 0) ** 3,
+                    x_in, x_rear)[0]
+        return rise - 2 * SIGMA * cos_t * (1 / strip_gap(x_in, 0) - 1 / h_rear)
+
+    x_in = brentq(mismatch, -1.9e-3, 0.99 * x_rear)
+    row = sol.flooded[0]
+    assert (sol.flooded == row).all()                  # no variation along y
+    xs = sol.grid.x[row]
+    assert abs(xs[-1] + cell / 2 - x_rear) <= cell
+    assert abs(xs[0] - cell / 2 - x_in) <= cell
+    assert abs(sol.flux_out / sol.flux_in - 1.0) < 0.02
+    assert sol.mass_balance_error < 1e-9
+
+
+def ball_gap(x, y):
+    """A rigid ball on a flat: 1 um at the contact, R = 9.525 mm."""
+    return 1e-6 + (np.asarray(x) ** 2 + np.asarray(y) ** 2) / (2 * 9.525e-3)
+
+
+A = 1.37e-4
+
+
+def ball_problem(**kw) -> ThinFilmProblem:
+    base = dict(gap=ball_gap, speed=0.008, viscosity=0.0216, surface_tension=SIGMA,
+                contact_angle=THETA, supply=16e-6, track_half_width=3e-4,
+                x_range=(-11 * A, 19 * A), y_max=11 * A, island_radius=1.5 * A,
+                cell=0.4 * A, initial_radius=7 * A)
+    return ThinFilmProblem(**(base | kw))
+
+
+def test_region_closes_round_the_island_and_keeps_its_oil():
+    sol = solve_thin_film(ball_problem(), transits_max=6, tolerance=0.0,
+                          transit_length=10 * A)
+    m = sol.metrics(A)
+    assert m["state"] == "I"
+    assert not m["touches_boundary"]
+    assert m["inlet_meniscus_distance_over_a"] > 1.0
+    assert m["rear_meniscus_x_over_a"] > 3.0
+    assert m["flooded_width_over_a"] > 6.0
+    assert sol.mass_balance_error < 1e-9
+    assert len(sol.history) == 6
+
+
+def test_thicker_films_hold_less_oil_in_a_narrower_region():
+    thin, thick = (solve_thin_film(ball_problem(film_factor=f), transits_max=6,
+                                   tolerance=0.0, transit_length=10 * A).metrics(A)
+                   for f in (1.0, 3.0))
+    assert thick["oil_volume_m3"] < 0.9 * thin["oil_volume_m3"]
+    assert thick["flooded_width_over_a"] < thin["flooded_width_over_a"]
+    assert thick["outflow_over_supply"] > thin["outflow_over_supply"]
+
+
+def _ring_grid(n=40):
+    d = 1.0 / n * 20 * A
+    x = -10 * A + d * (np.arange(n) + 0.5)
+    y = d * (np.arange(n // 2) + 0.5)
+    X, Y = np.meshgrid(x, y)
+    island = np.hypot(X, Y) < 1.5 * A
+    h = np.where(island, np.nan, 1e-5)
+    return Grid(x=x, y=y, h=h, hx=h[:, 1:], hy=h[1:], h_side=h[-1], island=island), X, Y
+
+
+def test_metrics_read_a_closed_ring_as_state_I_and_an_open_wake_as_state_II():
+    grid, X, Y = _ring_grid()
+    r = np.hypot(X, Y)
+    ring = (r < 6 * A) & ~grid.island
+    closed = region_metrics(ring, grid, A, 1.5 * A)
+    assert closed["state"] == "I"
+    assert closed["flooded_width_over_a"] == pytest.approx(12.0, abs=0.5)
+    assert closed["inlet_meniscus_distance_over_a"] == pytest.approx(5.0, abs=0.5)
+    pocket = ring & ~((r < 3 * A) & (X > 0))           # enclosed air behind the island
+    assert region_metrics(pocket, grid, A, 1.5 * A)["state"] == "I"
+    wake = ring & ~((X > 0) & (Y < 2 * A))             # the air behind reaches the outside
+    assert region_metrics(wake, grid, A, 1.5 * A)["state"] == "II"
+
+
+@pytest.mark.parametrize("key, value, words", [
+    ("cell", -1.0, "cell = -1.0 is out of range"),
+    ("contact_angle", 95.0, "contact_angle = 95.0 is out of range: must be in [0, 90) deg"),
+    ("supply", -1e-6, "supply = -1e-06 is out of range: must be >= 0 m"),
+    ("x_range", (0.0, 19 * A), "x_range"),
+])
+def test_bad_parameters_are_refused_by_name_and_range(key, value, words):
+    with pytest.raises(ValueError, match=words.replace("(", r"\(").replace(")", r"\)")
+                       .replace("[", r"\[")):
+        ball_problem(**{key: value})
