@@ -36,16 +36,20 @@ This is the mass-conserving cavitation model of lubrication (Elrod-Adams; Jakobs
 Floberg and Olsson's conditions) with two changes that make it a model of this flow: the
 boundary pressure is the meniscus's Young-Laplace pressure instead of a cavitation pressure,
 and a receding meniscus keeps all but Landau-Levich's films, where JFO lets the walls carry
-off all the oil at the rupture boundary. It neglects the in-plane curvature of the meniscus
-(sigma / R beside 2 sigma / h: about 1 %), the air's pressure drop, gravity and inertia
-(Re ~ 0.01), the films' own orientation (a meniscus at an angle to u lays the films of the
-normal speed) and dynamic contact angles. SI units throughout.
+off all the oil at the rupture boundary. Every meniscus has Young-Laplace's static
+pressure unless ``receding_meniscus = "bretherton"`` gives the meniscus that the walls leave
+behind the dynamic pressure of one laying films (Park and Homsy's Hele-Shaw result). It
+neglects the in-plane curvature of the meniscus (sigma / R beside 2 sigma / h: about 1 %),
+the air's pressure drop, gravity and inertia (Re ~ 0.01), the films' own orientation (a
+meniscus at an angle to u lays the films of the normal speed) and the dynamic contact angle
+of a meniscus advancing onto dry walls. SI units throughout.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 from scipy import ndimage
@@ -79,6 +83,12 @@ class ThinFilmProblem:
         film_factor: multiplies Landau-Levich's films (1: the model).
         closed_side: the side y = y_max is a symmetry plane too, not open to the air (a
             strip of a problem that does not vary along y).
+        receding_meniscus: the capillary pressure of a meniscus that the walls leave
+            behind (an open cell downstream of a flooded one): "static", Young-Laplace's
+            -2 sigma cos(theta) / h like every other; "bretherton", that of a meniscus laying
+            films (Park and Homsy 1984, Hele-Shaw): -(2 sigma / h) (1 + 3.8 Ca^(2/3)), with
+            no contact angle (the walls behind it are wet). At Ca = 0.006 it draws 16 %
+            harder than the static one.
     """
 
     gap: Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -95,6 +105,7 @@ class ThinFilmProblem:
     initial_radius: float
     film_factor: float = 1.0
     closed_side: bool = False
+    receding_meniscus: Literal["static", "bretherton"] = "static"
 
     def __post_init__(self) -> None:
         span = min(self.y_max / 2, (self.x_range[1] - self.x_range[0]) / 8)
@@ -113,6 +124,9 @@ class ThinFilmProblem:
             "cell": (self.cell, 0 < self.cell <= span, f"in (0, {span:.3g}] m: two cells "
                                                       "across, eight along the domain"),
             "film_factor": (self.film_factor, self.film_factor > 0, "> 0"),
+            "receding_meniscus": (self.receding_meniscus,
+                                  self.receding_meniscus in ("static", "bretherton"),
+                                  "'static' or 'bretherton'"),
         }
         for name, (value, ok, valid) in checks.items():
             if not ok:
@@ -316,13 +330,25 @@ class _Operators:
         self.pcap = np.where(grid.island, 0.0,
                              -2.0 * prob.surface_tension * cos_t / np.where(grid.island, 1.0,
                                                                               self.h))
+        self.pcap_receding = self.pcap.copy()
+        if prob.receding_meniscus == "bretherton":
+            ca = prob.viscosity * u / prob.surface_tension
+            self.pcap_receding = self.pcap / cos_t * (1.0 + 3.8 * ca ** (2.0 / 3.0))
         self.cap = prob.film * self.h                  # what a meniscus cell passes on [m]
         on_track = np.clip((prob.track_half_width - (grid.y - d / 2)) / d, 0.0, 1.0)
         self.q_supply = u * prob.supply * on_track * d  # into column 0 [m3/s]
 
+    def meniscus_pressure(self, flooded: np.ndarray) -> np.ndarray:
+        """The capillary pressure of every open cell [Pa]: the receding meniscus's in the
+        open cells downstream of a flooded one."""
+        behind = np.zeros_like(flooded)
+        behind[:, 1:] = flooded[:, :-1] & ~flooded[:, 1:]
+        return np.where(behind, self.pcap_receding, self.pcap)
+
     def pressure(self, flooded: np.ndarray, c: np.ndarray, dt: float) -> np.ndarray:
         """p on the flooded cells: each one's outflow is what it holds beyond its gap / dt."""
         ny, nx = flooded.shape
+        pcap = self.meniscus_pressure(flooded)
         n = int(flooded.sum())
         p = np.full((ny, nx), np.nan)
         if n == 0:
@@ -335,8 +361,8 @@ class _Operators:
         zeros_y = np.zeros_like(self.gy)
         for lo, hi, g, full, open_lo, pc_lo, pc_hi in (
                 (idx[:, :-1], idx[:, 1:], self.gx, self.cx, carried[:, :-1],
-                 self.pcap[:, :-1], self.pcap[:, 1:]),
-                (idx[:-1], idx[1:], self.gy, zeros_y, zeros_y, self.pcap[:-1], self.pcap[1:])):
+                 pcap[:, :-1], pcap[:, 1:]),
+                (idx[:-1], idx[1:], self.gy, zeros_y, zeros_y, pcap[:-1], pcap[1:])):
             lo, hi, g = lo.ravel(), hi.ravel(), g.ravel()
             full, open_lo, pc_lo, pc_hi = full.ravel(), open_lo.ravel(), pc_lo.ravel(), pc_hi.ravel()
             both = (lo >= 0) & (hi >= 0) & (g > 0)
@@ -386,7 +412,7 @@ class _Operators:
         from it is cut back first (the flooded cell runs short of a full gap), the films
         and layers it passes on only when that is not enough."""
         u, d = self.u, self.d
-        pf = np.where(flooded, p, self.pcap)
+        pf = np.where(flooded, p, self.meniscus_pressure(flooded))
         fl, fr = flooded[:, :-1], flooded[:, 1:]
         touch = _touches(flooded) & ~self.island
         # x faces lo -> hi: Poiseuille where a side is flooded, plus what the walls carry:

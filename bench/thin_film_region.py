@@ -1,0 +1,158 @@
+"""The flooded region in the thin-film limit (``ehl_precalc.meniscus_reynolds``) on a series of
+grids and steps: what the gap-averaged flow with Landau-Levich films makes of a case spec,
+converged on its own grid, beside the 3D interface cases.
+
+Each run marches the spec's contact, oil, supply and wetting from the spec's initial puddle
+(or from the previous run's state with ``--chain``) for ``--transits`` transits of the spec
+(``run.transit_length`` a at u), or until the outflow balances the supply (``--balance``).
+It prints the metrics per run and writes ``bench/results/thin_film_region[_TAG].json``
+after every run (atomically), the states to ``runs/bench/thin_film/TAG/`` and, with
+``--plot``, the menisci of all runs on one picture.
+
+    python bench/thin_film_region.py [SPEC] [--cells 0.2 0.1 0.05] [--courant 0.5 ...]
+        [--film-factor 1 ...] [--receding static bretherton] [--transits 10] [--balance] [--chain] [--domain -11 19 11]
+        [--set KEY=VALUE ...] [--tag NAME] [--plot FILE.png]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from bench.common import save, spec_option  # noqa: E402
+from ehl_precalc.meniscus_reynolds import (ThinFilmProblem, ThinFilmSolution,  # noqa: E402
+                                           solve_thin_film)
+from generator.case_spec import CaseSpec, load_case_spec  # noqa: E402
+from generator.gap_source import load_gap  # noqa: E402
+
+WORK = ROOT / "runs" / "bench" / "thin_film"
+
+
+def problem_from_spec(spec: CaseSpec, gap, cell: float, domain: tuple[float, float, float],
+                      film_factor: float = 1.0, receding: str = "static") -> ThinFilmProblem:
+    """The thin-film problem of a case spec: its contact, oil, wetting and supply ("layers":
+    both layers on the track; "flooded": the whole inlet gap on the track), ``cell`` and
+    ``domain`` = (x_min, x_max, y_max) in units of a."""
+    a = spec.a
+    sup = spec.supply
+    supply = sup.disc_layer + sup.ball_layer
+    if sup.mode == "flooded":
+        supply = float(gap(np.array([domain[0] * a]), np.array([0.0]))[0])
+    elif sup.mode != "layers":
+        raise ValueError(f"supply.mode = {sup.mode!r}: the thin-film model takes 'layers' or "
+                         "'flooded'")
+    return ThinFilmProblem(
+        gap=gap, speed=spec.speed, viscosity=spec.oil_viscosity,
+        surface_tension=spec.physics.surface_tension, contact_angle=spec.physics.contact_angle,
+        supply=supply, track_half_width=sup.track_half_width,
+        x_range=(domain[0] * a, domain[1] * a), y_max=domain[2] * a,
+        island_radius=spec.domain.island_radius * a, cell=cell * a,
+        initial_radius=sup.initial_puddle * a, film_factor=film_factor,
+        receding_meniscus=receding)
+
+
+def save_state(sol: ThinFilmSolution, path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(path, x=sol.grid.x, y=sol.grid.y, h=sol.grid.h, flooded=sol.flooded,
+                        content=sol.content)
+
+
+def plot_menisci(records: list[dict], a: float, out: Path) -> None:
+    """The outline of each run's flooded region on one top view."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 3.4))
+    for rec in records:
+        d = np.load(rec["state"])
+        region = d["flooded"].astype(float)
+        ax.contour(d["x"] / a, d["y"] / a, region, levels=[0.5], linewidths=1.2,
+                   colors=[plt.cm.viridis(rec["index"] / max(len(records) - 1, 1))])
+        ax.plot([], [], color=plt.cm.viridis(rec["index"] / max(len(records) - 1, 1)),
+                label=f"{rec['label']}: width {rec['metrics']['flooded_width_over_a']:.2f} a")
+    ax.add_patch(plt.Circle((0, 0), 1.0, color="0.3"))
+    ax.set_aspect("equal")
+    ax.set_xlabel("x / a (rolling ->)")
+    ax.set_ylabel("y / a")
+    ax.set_title("thin-film model: flooded region (half domain)")
+    ax.legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    fig.savefig(out, dpi=130)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("spec", nargs="?", default=str(ROOT / "runs" / "nominal.toml"))
+    ap.add_argument("--cells", nargs="+", type=float, default=[0.2, 0.1],
+                    help="cell sizes, units of a")
+    ap.add_argument("--courant", nargs="+", type=float, default=[0.5],
+                    help="step over a cell's transit at u")
+    ap.add_argument("--film-factor", nargs="+", type=float, default=[1.0])
+    ap.add_argument("--receding", nargs="+", default=["static"],
+                    choices=["static", "bretherton"],
+                    help="the receding meniscus's capillary pressure")
+    ap.add_argument("--transits", type=float, default=10.0)
+    ap.add_argument("--balance", action="store_true",
+                    help="stop when the outflow balances the supply (tolerance 1 %%)")
+    ap.add_argument("--chain", action="store_true",
+                    help="start each run from the previous one's state")
+    ap.add_argument("--domain", nargs=3, type=float, default=[-11.0, 19.0, 11.0],
+                    metavar=("X_MIN", "X_MAX", "Y_MAX"), help="units of a")
+    ap.add_argument("--set", action="append", default=[], type=spec_option,
+                    metavar="KEY=VALUE", help="spec options")
+    ap.add_argument("--tag", default="")
+    ap.add_argument("--plot", default="", help="a PNG of the menisci of all runs")
+    args = ap.parse_args(argv)
+    spec = load_case_spec(args.spec, **dict(args.set))
+    gap, _ = load_gap(spec.contact)
+    a = spec.a
+    name = f"thin_film_region{'_' + args.tag if args.tag else ''}"
+    record = {"spec": args.spec, "set": dict(args.set), "domain_over_a": args.domain,
+              "transits": args.transits, "balance": args.balance, "chain": args.chain,
+              "transit_s": spec.transit_time, "runs": []}
+    start = None
+    print(f"{'cell/a':>7} {'Co':>5} {'film':>5} {'recede':>6} {'transits':>8} {'state':>5} {'inlet/a':>8} "
+          f"{'width/a':>8} {'length/a':>8} {'rear/a':>7} {'oil nl':>8} {'out/in':>7} "
+          f"{'wall s':>7}", flush=True)
+    for receding, ff, courant, cell in itertools.product(args.receding, args.film_factor,
+                                                          args.courant, args.cells):
+        prob = problem_from_spec(spec, gap, cell, tuple(args.domain), ff, receding)
+        t0 = time.perf_counter()
+        sol = solve_thin_film(prob, transits_max=args.transits,
+                              tolerance=0.01 if args.balance else 0.0,
+                              transit_length=spec.run.transit_length * a,
+                              start=start if args.chain else None, courant=courant)
+        wall = time.perf_counter() - t0
+        m = sol.metrics(a)
+        label = f"{cell:g} a, Co {courant:g}, {ff:g} LL, {receding}"
+        state = WORK / (args.tag or "default") / f"{cell:g}_{courant:g}_{ff:g}_{receding}.npz"
+        save_state(sol, state)
+        record["runs"].append({"index": len(record["runs"]), "label": label,
+                               "cell_over_a": cell, "courant": courant, "film_factor": ff,
+                               "receding_meniscus": receding, "wall_s": wall, "metrics": m,
+                               "history": sol.history, "state": str(state)})
+        save(f"{name}.json", record)
+        start = sol
+        print(f"{cell:7.3f} {courant:5.2f} {ff:5.2f} {receding[:6]:>6} "
+              f"{sol.time / spec.transit_time:8.1f} {m['state']:>5} "
+              f"{m['inlet_meniscus_distance_over_a'] or 0:8.2f} "
+              f"{m['flooded_width_over_a'] or 0:8.2f} {m['flooded_length_over_a'] or 0:8.2f} "
+              f"{m['rear_meniscus_x_over_a'] or 0:7.2f} {m['oil_volume_m3'] * 1e12:8.1f} "
+              f"{m['outflow_over_supply'] or 0:7.3f} {wall:7.0f}", flush=True)
+    if args.plot:
+        plot_menisci(record["runs"], a, Path(args.plot))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
