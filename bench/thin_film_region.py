@@ -9,8 +9,9 @@ It prints the metrics per run and writes ``bench/results/thin_film_region[_TAG].
 after every run (atomically), the states to ``runs/bench/thin_film/TAG/`` and, with
 ``--plot``, the menisci of all runs on one picture.
 
-    python bench/thin_film_region.py [SPEC] [--cells 0.2 0.1 0.05] [--courant 0.5 ...]
-        [--film-factor 1 ...] [--receding static bretherton] [--transits 10] [--balance] [--chain] [--domain -11 19 11]
+    python bench/thin_film_region.py [SPEC] [--cells 0.2 0.1 0.05] [--courant 0.25 ...]
+        [--film-factor 1 ...] [--receding static bretherton] [--transits 10]
+        [--balance [--tolerance 0.01]] [--chain] [--domain -11 19 11]
         [--set KEY=VALUE ...] [--tag NAME] [--plot FILE.png]
 """
 
@@ -95,7 +96,7 @@ def main(argv=None) -> int:
     ap.add_argument("spec", nargs="?", default=str(ROOT / "runs" / "nominal.toml"))
     ap.add_argument("--cells", nargs="+", type=float, default=[0.2, 0.1],
                     help="cell sizes, units of a")
-    ap.add_argument("--courant", nargs="+", type=float, default=[0.5],
+    ap.add_argument("--courant", nargs="+", type=float, default=[0.25],
                     help="step over a cell's transit at u")
     ap.add_argument("--film-factor", nargs="+", type=float, default=[1.0])
     ap.add_argument("--receding", nargs="+", default=["static"],
@@ -103,7 +104,10 @@ def main(argv=None) -> int:
                     help="the receding meniscus's capillary pressure")
     ap.add_argument("--transits", type=float, default=10.0)
     ap.add_argument("--balance", action="store_true",
-                    help="stop when the outflow balances the supply (tolerance 1 %%)")
+                    help="stop when the outflow balances the supply and the oil stands")
+    ap.add_argument("--tolerance", type=float, default=0.01,
+                    help="of --balance: outflow / supply within it of 1 and the oil "
+                         "changed by less than it over a transit")
     ap.add_argument("--chain", action="store_true",
                     help="start each run from the previous one's state")
     ap.add_argument("--domain", nargs=3, type=float, default=[-11.0, 19.0, 11.0],
@@ -119,6 +123,7 @@ def main(argv=None) -> int:
     name = f"thin_film_region{'_' + args.tag if args.tag else ''}"
     record = {"spec": args.spec, "set": dict(args.set), "domain_over_a": args.domain,
               "transits": args.transits, "balance": args.balance, "chain": args.chain,
+              "tolerance": args.tolerance if args.balance else None,
               "transit_s": spec.transit_time, "runs": []}
     start = None
     print(f"{'cell/a':>7} {'Co':>5} {'film':>5} {'recede':>6} {'transits':>8} {'state':>5} {'inlet/a':>8} "
@@ -129,7 +134,7 @@ def main(argv=None) -> int:
         prob = problem_from_spec(spec, gap, cell, tuple(args.domain), ff, receding)
         t0 = time.perf_counter()
         sol = solve_thin_film(prob, transits_max=args.transits,
-                              tolerance=0.01 if args.balance else 0.0,
+                              tolerance=args.tolerance if args.balance else 0.0,
                               transit_length=spec.run.transit_length * a,
                               start=start if args.chain else None, courant=courant)
         wall = time.perf_counter() - t0

@@ -30,7 +30,8 @@ It is marched in time to a steady state: each step solves p on the flooded cells
 scipy; a flooded cell's outflow is zero, or returns oil it holds beyond its gap), moves the
 oil, and an open cell that fills becomes flooded while a flooded cell that the region drains
 (it draws more from an open neighbour than that holds: air comes in) becomes open. The oil is
-conserved to round-off; the step is half a cell's transit at u.
+conserved to round-off; the step is a quarter of a cell's transit at u (the oil held after
+10 nominal transits moves 0.3 % from there to an eighth, 3.5 % to a half).
 
 This is the mass-conserving cavitation model of lubrication (Elrod-Adams; Jakobsson,
 Floberg and Olsson's conditions) with two changes that make it a model of this flow: the
@@ -246,7 +247,7 @@ def region_metrics(region: np.ndarray, grid: Grid, a: float, island_radius: floa
 
 def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,
                     tolerance: float = 0.01, transit_length: float | None = None,
-                    start: ThinFilmSolution | None = None, courant: float = 0.5,
+                    start: ThinFilmSolution | None = None, courant: float = 0.25,
                     progress: Callable[[dict], None] | None = None) -> ThinFilmSolution:
     """March ``prob`` until steady or for ``transits_max`` transits (a transit:
     ``transit_length`` [m] at u, by default the domain's length). Steady: over the last
@@ -277,7 +278,7 @@ def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,
     while step < transits_max * steps_per_transit:
         p, dc, q_out, opened = ops.step(flooded, c, dt)
         c = c + dc
-        flooded = (flooded | (c >= h * (1.0 - 1e-9))) & ~opened & ~grid.island
+        flooded = (c >= h * (1.0 - 1e-9)) & ~opened & ~grid.island
         step += 1
         oil_in += q_in * dt
         oil_out += q_out * dt

@@ -137,3 +137,32 @@ def test_bad_parameters_are_refused_by_name_and_range(key, value, words):
     with pytest.raises(ValueError, match=words.replace("(", r"\(").replace(")", r"\)")
                        .replace("[", r"\[")):
         ball_problem(**{key: value})
+
+
+def test_a_case_spec_becomes_the_same_problem():
+    """bench/thin_film_region.py reads the spec's contact, oil, wetting and supply."""
+    from bench.thin_film_region import problem_from_spec
+    from generator.case_spec import make_case_spec
+
+    spec = make_case_spec({"supply": {"mode": "layers", "disc_layer": 5e-6, "ball_layer": 3e-6,
+                                      "track_half_width": 2e-4, "initial_puddle": 6.0},
+                           "physics": {"contact_angle": 20.0}})
+    a = spec.a
+    prob = problem_from_spec(spec, ball_gap, 0.25, (-10.0, 18.0, 9.0), film_factor=2.0,
+                             receding="bretherton")
+    assert prob.supply == pytest.approx(8e-6)
+    assert prob.track_half_width == pytest.approx(2e-4)
+    assert prob.initial_radius == pytest.approx(6 * a)
+    assert prob.island_radius == pytest.approx(spec.domain.island_radius * a)
+    assert prob.x_range == pytest.approx((-10 * a, 18 * a)) and prob.y_max == pytest.approx(9 * a)
+    assert prob.cell == pytest.approx(0.25 * a)
+    assert (prob.speed, prob.viscosity) == (spec.speed, spec.oil_viscosity)
+    assert (prob.contact_angle, prob.receding_meniscus) == (20.0, "bretherton")
+    assert prob.film == pytest.approx(2 * landau_levich(spec.oil_viscosity, spec.speed,
+                                                        spec.physics.surface_tension))
+    flooded = make_case_spec({"supply": {"mode": "flooded"}})
+    prob = problem_from_spec(flooded, ball_gap, 0.25, (-10.0, 18.0, 9.0))
+    assert prob.supply == pytest.approx(ball_gap(-10 * flooded.a, 0.0))   # the whole inlet gap
+    with pytest.raises(ValueError, match="supply.mode = 'submerged'"):
+        problem_from_spec(make_case_spec({"supply": {"mode": "submerged"}}), ball_gap, 0.25,
+                          (-10.0, 18.0, 9.0))
