@@ -13,6 +13,7 @@ after every run (atomically), the states to ``runs/bench/thin_film/TAG/`` and, w
         [--film-factor 1 ...] [--receding static bretherton] [--transits 10]
         [--balance [--tolerance 0.01]] [--chain] [--domain -11 19 11]
         [--set KEY=VALUE ...] [--tag NAME] [--plot FILE.png]
+    python bench/thin_film_region.py --plot FILE.png --plot-records RECORD.json ...
 """
 
 from __future__ import annotations
@@ -116,7 +117,16 @@ def main(argv=None) -> int:
                     metavar="KEY=VALUE", help="spec options")
     ap.add_argument("--tag", default="")
     ap.add_argument("--plot", default="", help="a PNG of the menisci of all runs")
+    ap.add_argument("--plot-records", nargs="+", default=[], metavar="RECORD.json",
+                    help="with --plot: draw the runs of these records, run nothing")
     args = ap.parse_args(argv)
+    if args.plot_records:
+        import json
+
+        runs = [run for r in args.plot_records for run in json.loads(Path(r).read_text())["runs"]]
+        runs = [run | {"index": i} for i, run in enumerate(runs)]
+        plot_menisci(runs, load_case_spec(args.spec, **dict(args.set)).a, Path(args.plot))
+        return 0
     spec = load_case_spec(args.spec, **dict(args.set))
     gap, _ = load_gap(spec.contact)
     a = spec.a
