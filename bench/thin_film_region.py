@@ -10,7 +10,7 @@ after every run (atomically), the states to ``runs/bench/thin_film/TAG/`` and, w
 ``--plot``, the menisci of all runs on one picture.
 
     python bench/thin_film_region.py [SPEC] [--cells 0.2 0.1 0.05] [--courant 0.25 ...]
-        [--film-factor 1 ...] [--receding static bretherton] [--transits 10]
+        [--film-factor 1 ...] [--receding static bretherton 1.05 ...] [--transits 10]
         [--balance [--tolerance 0.01]] [--chain] [--domain -11 19 11]
         [--set KEY=VALUE ...] [--tag NAME] [--plot FILE.png]
     python bench/thin_film_region.py --plot FILE.png --plot-records RECORD.json ...
@@ -39,7 +39,8 @@ WORK = ROOT / "runs" / "bench" / "thin_film"
 
 
 def problem_from_spec(spec: CaseSpec, gap, cell: float, domain: tuple[float, float, float],
-                      film_factor: float = 1.0, receding: str = "static") -> ThinFilmProblem:
+                      film_factor: float = 1.0,
+                      receding: str | float = "static") -> ThinFilmProblem:
     """The thin-film problem of a case spec: its contact, oil, wetting and supply ("layers":
     both layers on the track; "flooded": the whole inlet gap on the track), ``cell`` and
     ``domain`` = (x_min, x_max, y_max) in units of a."""
@@ -59,6 +60,17 @@ def problem_from_spec(spec: CaseSpec, gap, cell: float, domain: tuple[float, flo
         island_radius=spec.domain.island_radius * a, cell=cell * a,
         initial_radius=sup.initial_puddle * a, film_factor=film_factor,
         receding_meniscus=receding)
+
+
+def _receding(text: str) -> str | float:
+    """--receding: 'static', 'bretherton' or a number."""
+    if text in ("static", "bretherton"):
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"--receding {text!r}: 'static', 'bretherton' or a factor in [0.5, 2]") from None
 
 
 def save_state(sol: ThinFilmSolution, path: Path) -> None:
@@ -100,9 +112,9 @@ def main(argv=None) -> int:
     ap.add_argument("--courant", nargs="+", type=float, default=[0.25],
                     help="step over a cell's transit at u")
     ap.add_argument("--film-factor", nargs="+", type=float, default=[1.0])
-    ap.add_argument("--receding", nargs="+", default=["static"],
-                    choices=["static", "bretherton"],
-                    help="the receding meniscus's capillary pressure")
+    ap.add_argument("--receding", nargs="+", default=["static"], type=_receding,
+                    help="the receding meniscus's capillary pressure: static, bretherton or "
+                         "a factor on the static one")
     ap.add_argument("--transits", type=float, default=10.0)
     ap.add_argument("--balance", action="store_true",
                     help="stop when the outflow balances the supply and the oil stands")
@@ -158,7 +170,7 @@ def main(argv=None) -> int:
                                "history": sol.history, "state": str(state)})
         save(f"{name}.json", record)
         start = sol
-        print(f"{cell:7.3f} {courant:5.2f} {ff:5.2f} {receding[:6]:>6} "
+        print(f"{cell:7.3f} {courant:5.2f} {ff:5.2f} {str(receding)[:6]:>6} "
               f"{sol.time / spec.transit_time:8.1f} {m['state']:>5} "
               f"{m['inlet_meniscus_distance_over_a'] or 0:8.2f} "
               f"{m['flooded_width_over_a'] or 0:8.2f} {m['flooded_length_over_a'] or 0:8.2f} "

@@ -38,8 +38,9 @@ Floberg and Olsson's conditions) with two changes that make it a model of this f
 boundary pressure is the meniscus's Young-Laplace pressure instead of a cavitation pressure,
 and a receding meniscus keeps all but Landau-Levich's films, where JFO lets the walls carry
 off all the oil at the rupture boundary. Every meniscus has Young-Laplace's static
-pressure unless ``receding_meniscus = "bretherton"`` gives the meniscus that the walls leave
-behind the dynamic pressure of one laying films (Park and Homsy's Hele-Shaw result). It
+pressure unless ``receding_meniscus`` gives the meniscus that the walls leave the dynamic
+pressure of one laying films ("bretherton": Park and Homsy's Hele-Shaw result) or a given
+factor on the static one (a number), falling off with the angle at which the walls leave it. It
 neglects the in-plane curvature of the meniscus (sigma / R beside 2 sigma / h: about 1 %),
 the air's pressure drop, gravity and inertia (Re ~ 0.01), the films' own orientation (a
 meniscus at an angle to u lays the films of the normal speed) and the dynamic contact angle
@@ -85,11 +86,15 @@ class ThinFilmProblem:
         closed_side: the side y = y_max is a symmetry plane too, not open to the air (a
             strip of a problem that does not vary along y).
         receding_meniscus: the capillary pressure of a meniscus that the walls leave
-            behind (an open cell downstream of a flooded one): "static", Young-Laplace's
+            (at the region's rear): "static", Young-Laplace's
             -2 sigma cos(theta) / h like every other; "bretherton", that of a meniscus laying
             films (Park and Homsy 1984, Hele-Shaw): -(2 sigma / h) (1 + 3.8 Ca^(2/3)), with
-            no contact angle (the walls behind it are wet). At Ca = 0.006 it draws 16 %
-            harder than the static one.
+            no contact angle (the walls behind it are wet), at the rear where the walls leave
+            it square on; at Ca = 0.006 that draws 16 % harder than the static one. A number
+            in [0.5, 2]: that factor on the static pressure there (to measure how much the
+            region hangs on it). Either way the factor falls off as n^(2/3) where the walls
+            leave the meniscus at an angle (n the x part of its outward normal; the films'
+            Ca n) and is 1 where they run along it or into it.
     """
 
     gap: Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -106,7 +111,7 @@ class ThinFilmProblem:
     initial_radius: float
     film_factor: float = 1.0
     closed_side: bool = False
-    receding_meniscus: Literal["static", "bretherton"] = "static"
+    receding_meniscus: Literal["static", "bretherton"] | float = "static"
 
     def __post_init__(self) -> None:
         span = min(self.y_max / 2, (self.x_range[1] - self.x_range[0]) / 8)
@@ -126,8 +131,11 @@ class ThinFilmProblem:
                                                       "across, eight along the domain"),
             "film_factor": (self.film_factor, self.film_factor > 0, "> 0"),
             "receding_meniscus": (self.receding_meniscus,
-                                  self.receding_meniscus in ("static", "bretherton"),
-                                  "'static' or 'bretherton'"),
+                                  self.receding_meniscus in ("static", "bretherton")
+                                  or (isinstance(self.receding_meniscus, (int, float))
+                                      and not isinstance(self.receding_meniscus, bool)
+                                      and 0.5 <= self.receding_meniscus <= 2.0),
+                                  "'static', 'bretherton' or a factor in [0.5, 2]"),
         }
         for name, (value, ok, valid) in checks.items():
             if not ok:
@@ -331,20 +339,29 @@ class _Operators:
         self.pcap = np.where(grid.island, 0.0,
                              -2.0 * prob.surface_tension * cos_t / np.where(grid.island, 1.0,
                                                                               self.h))
-        self.pcap_receding = self.pcap.copy()
-        if prob.receding_meniscus == "bretherton":
+        if prob.receding_meniscus == "bretherton":   # the pull where the walls leave at u
             ca = prob.viscosity * u / prob.surface_tension
-            self.pcap_receding = self.pcap / cos_t * (1.0 + 3.8 * ca ** (2.0 / 3.0))
+            self.pull = (1.0 + 3.8 * ca ** (2.0 / 3.0)) / cos_t
+        elif prob.receding_meniscus == "static":
+            self.pull = 1.0
+        else:
+            self.pull = float(prob.receding_meniscus)
         self.cap = prob.film * self.h                  # what a meniscus cell passes on [m]
         on_track = np.clip((prob.track_half_width - (grid.y - d / 2)) / d, 0.0, 1.0)
         self.q_supply = u * prob.supply * on_track * d  # into column 0 [m3/s]
 
     def meniscus_pressure(self, flooded: np.ndarray) -> np.ndarray:
-        """The capillary pressure of every open cell [Pa]: the receding meniscus's in the
-        open cells downstream of a flooded one."""
-        behind = np.zeros_like(flooded)
-        behind[:, 1:] = flooded[:, :-1] & ~flooded[:, 1:]
-        return np.where(behind, self.pcap_receding, self.pcap)
+        """The capillary pressure of every open cell [Pa]: the static one, times
+        1 + (pull - 1) n^(2/3) where the walls leave the meniscus at u n (n: the x part of its
+        outward normal, from the flooded cells smoothed over a cell and a half; Ca n is the
+        capillary number of the films it lays), so that a meniscus at an angle to u is not
+        left to the staircase of the cells."""
+        if self.pull == 1.0:
+            return self.pcap
+        phi = ndimage.gaussian_filter(flooded.astype(float), 1.5, mode="nearest")
+        gy, gx = np.gradient(phi)
+        n = np.clip(-gx / np.maximum(np.hypot(gx, gy), 1e-12), 0.0, 1.0)
+        return self.pcap * (1.0 + (self.pull - 1.0) * n ** (2.0 / 3.0))
 
     def pressure(self, flooded: np.ndarray, c: np.ndarray, dt: float) -> np.ndarray:
         """p on the flooded cells: each one's outflow is what it holds beyond its gap / dt."""
