@@ -148,7 +148,8 @@ def main(argv=None) -> int:
               "tolerance": args.tolerance if args.balance else None,
               "transit_s": spec.transit_time, "runs": []}
     start = None
-    print(f"{'cell/a':>7} {'Co':>5} {'film':>5} {'recede':>6} {'transits':>8} {'state':>5} {'inlet/a':>8} "
+    print(f"{'cell/a':>7} {'Co':>5} {'film':>5} {'recede':>6} {'transits':>8} {'state':>5} "
+          f"{'inlet/a':>8} "
           f"{'width/a':>8} {'length/a':>8} {'rear/a':>7} {'oil nl':>8} {'out/in':>7} "
           f"{'wall s':>7}", flush=True)
     for receding, ff, courant, cell in itertools.product(args.receding, args.film_factor,

@@ -363,10 +363,11 @@ class _Operators:
         n = np.clip(-gx / np.maximum(np.hypot(gx, gy), 1e-12), 0.0, 1.0)
         return self.pcap * (1.0 + (self.pull - 1.0) * n ** (2.0 / 3.0))
 
-    def pressure(self, flooded: np.ndarray, c: np.ndarray, dt: float) -> np.ndarray:
-        """p on the flooded cells: each one's outflow is what it holds beyond its gap / dt."""
+    def pressure(self, flooded: np.ndarray, c: np.ndarray, dt: float,
+                 pcap: np.ndarray) -> np.ndarray:
+        """p on the flooded cells, the open ones at ``pcap``: each flooded cell's outflow is
+        what it holds beyond its gap / dt."""
         ny, nx = flooded.shape
-        pcap = self.meniscus_pressure(flooded)
         n = int(flooded.sum())
         p = np.full((ny, nx), np.nan)
         if n == 0:
@@ -382,7 +383,8 @@ class _Operators:
                  pcap[:, :-1], pcap[:, 1:]),
                 (idx[:-1], idx[1:], self.gy, zeros_y, zeros_y, pcap[:-1], pcap[1:])):
             lo, hi, g = lo.ravel(), hi.ravel(), g.ravel()
-            full, open_lo, pc_lo, pc_hi = full.ravel(), open_lo.ravel(), pc_lo.ravel(), pc_hi.ravel()
+            full, open_lo = full.ravel(), open_lo.ravel()
+            pc_lo, pc_hi = pc_lo.ravel(), pc_hi.ravel()
             both = (lo >= 0) & (hi >= 0) & (g > 0)
             a, b, gg = lo[both], hi[both], g[both]
             rows += [a, b, a, b]
@@ -415,8 +417,9 @@ class _Operators:
         flooded cell that would run dry within the step opens now, and p is solved again."""
         opened = np.zeros_like(flooded)
         for _ in range(1000):
-            p = self.pressure(flooded, c, dt)
-            dc, q_out = self.move(flooded, p, c, dt)
+            pcap = self.meniscus_pressure(flooded)
+            p = self.pressure(flooded, c, dt, pcap)
+            dc, q_out = self.move(flooded, p, c, dt, pcap)
             dry = flooded & (c + dc < 0.0)
             if not dry.any():
                 return p, dc, q_out, opened
@@ -424,13 +427,14 @@ class _Operators:
             flooded = flooded & ~dry
         raise RuntimeError("the flooded set did not settle within a step")
 
-    def move(self, flooded: np.ndarray, p: np.ndarray, c: np.ndarray, dt: float):
+    def move(self, flooded: np.ndarray, p: np.ndarray, c: np.ndarray, dt: float,
+             pcap: np.ndarray):
         """The change of the oil in every cell over dt [m] and the flux leaving the domain
-        [m3/s]. An open cell gives no more than it holds: what the flooded region draws
-        from it is cut back first (the flooded cell runs short of a full gap), the films
-        and layers it passes on only when that is not enough."""
+        [m3/s], the open cells at ``pcap``. An open cell gives no more than it holds: what
+        the flooded region draws from it is cut back first (the flooded cell runs short of a
+        full gap), the films and layers it passes on only when that is not enough."""
         u, d = self.u, self.d
-        pf = np.where(flooded, p, self.meniscus_pressure(flooded))
+        pf = np.where(flooded, p, pcap)
         fl, fr = flooded[:, :-1], flooded[:, 1:]
         touch = _touches(flooded) & ~self.island
         # x faces lo -> hi: Poiseuille where a side is flooded, plus what the walls carry:
@@ -472,8 +476,8 @@ class _Operators:
                 short &= give > 0
                 if not short.any():
                     break
-                scale = np.where(short, np.clip((held + net + give) / np.where(short, give, 1.0),
-                                                0.0, 1.0 - 1e-12), 1.0)
+                room = (held + net + give) / np.where(short, give, 1.0)
+                scale = np.where(short, np.clip(room, 0.0, 1.0 - 1e-12), 1.0)
                 sx = np.where(qx > 0, scale[:, :-1], scale[:, 1:])
                 sy = np.where(qy > 0, scale[:-1], scale[1:])
                 qx = np.where(mx, qx * sx, qx)
