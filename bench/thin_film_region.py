@@ -11,7 +11,8 @@ after every run (atomically), the states to ``runs/bench/thin_film/TAG/`` and, w
 
     python bench/thin_film_region.py [SPEC] [--cells 0.2 0.1 0.05] [--courant 0.25 ...]
         [--film-factor 1 ...] [--receding static bretherton 1.05 ...] [--transits 10]
-        [--balance [--tolerance 0.01]] [--chain] [--domain -11 19 11]
+        [--normal-length 0.3 ...] [--meniscus sub-cell cell] [--balance [--tolerance 0.01] [--window 5]] [--chain]
+        [--start STATE.npz] [--domain -11 19 11]
         [--set KEY=VALUE ...] [--tag NAME] [--plot FILE.png]
     python bench/thin_film_region.py --plot FILE.png --plot-records RECORD.json ...
 """
@@ -30,8 +31,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save, spec_option  # noqa: E402
-from ehl_precalc.meniscus_reynolds import (ThinFilmProblem, ThinFilmSolution,  # noqa: E402
-                                           solve_thin_film)
+from ehl_precalc.meniscus_reynolds import (Grid, ThinFilmProblem,  # noqa: E402
+                                           ThinFilmSolution, solve_thin_film)
 from generator.case_spec import CaseSpec, load_case_spec  # noqa: E402
 from generator.gap_source import load_gap  # noqa: E402
 
@@ -39,11 +40,13 @@ WORK = ROOT / "runs" / "bench" / "thin_film"
 
 
 def problem_from_spec(spec: CaseSpec, gap, cell: float, domain: tuple[float, float, float],
-                      film_factor: float = 1.0,
-                      receding: str | float = "static") -> ThinFilmProblem:
+                      film_factor: float = 1.0, receding: str | float = "static",
+                      normal_length: float | None = None,
+                      meniscus_position: str = "sub-cell") -> ThinFilmProblem:
     """The thin-film problem of a case spec: its contact, oil, wetting and supply ("layers":
-    both layers on the track; "flooded": the whole inlet gap on the track), ``cell`` and
-    ``domain`` = (x_min, x_max, y_max) in units of a."""
+    both layers on the track; "flooded": the whole inlet gap on the track), ``cell``,
+    ``domain`` = (x_min, x_max, y_max) and ``normal_length`` (None: 1.5 cells) in units of
+    a."""
     a = spec.a
     sup = spec.supply
     supply = sup.disc_layer + sup.ball_layer
@@ -59,7 +62,9 @@ def problem_from_spec(spec: CaseSpec, gap, cell: float, domain: tuple[float, flo
         x_range=(domain[0] * a, domain[1] * a), y_max=domain[2] * a,
         island_radius=spec.domain.island_radius * a, cell=cell * a,
         initial_radius=sup.initial_puddle * a, film_factor=film_factor,
-        receding_meniscus=receding)
+        receding_meniscus=receding,
+        normal_length=None if normal_length is None else normal_length * a,
+        meniscus_position=meniscus_position)
 
 
 def _receding(text: str) -> str | float:
@@ -77,6 +82,17 @@ def save_state(sol: ThinFilmSolution, path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(path, x=sol.grid.x, y=sol.grid.y, h=sol.grid.h, flooded=sol.flooded,
                         content=sol.content)
+
+
+def load_state(path: Path) -> ThinFilmSolution:
+    """A state written by ``save_state``, enough of it to start a run from (its grid's cells,
+    gaps and oil)."""
+    d = np.load(path)
+    grid = Grid(x=d["x"], y=d["y"], h=d["h"], hx=np.empty((0, 0)), hy=np.empty((0, 0)),
+                h_side=np.empty(0), island=np.isnan(d["h"]))
+    return ThinFilmSolution(grid=grid, p=np.full(d["h"].shape, np.nan), content=d["content"],
+                            flooded=d["flooded"], time=0.0, steps=0, flux_in=0.0,
+                            flux_out=0.0, steady=False, island_radius=0.0)
 
 
 def plot_menisci(records: list[dict], a: float, out: Path) -> None:
@@ -115,14 +131,24 @@ def main(argv=None) -> int:
     ap.add_argument("--receding", nargs="+", default=["static"], type=_receding,
                     help="the receding meniscus's capillary pressure: static, bretherton or "
                          "a factor on the static one")
+    ap.add_argument("--normal-length", nargs="+", type=float, default=[None],
+                    help="units of a: the smoothing of the region for the receding "
+                         "meniscus's normal (default 1.5 cells)")
+    ap.add_argument("--meniscus", nargs="+", default=["sub-cell"], choices=["sub-cell", "cell"],
+                    help="where a meniscus sits in its open cell (ThinFilmProblem."
+                         "meniscus_position)")
     ap.add_argument("--transits", type=float, default=10.0)
     ap.add_argument("--balance", action="store_true",
                     help="stop when the outflow balances the supply and the oil stands")
     ap.add_argument("--tolerance", type=float, default=0.01,
-                    help="of --balance: outflow / supply within it of 1 and the oil "
-                         "changed by less than it over a transit")
+                    help="of --balance: the mean outflow / supply within it of 1 and the "
+                         "oil changed by less than it over --window transits")
+    ap.add_argument("--window", type=int, default=5, help="of --balance, transits")
     ap.add_argument("--chain", action="store_true",
                     help="start each run from the previous one's state")
+    ap.add_argument("--start", default="", metavar="STATE.npz",
+                    help="start from a state a run wrote (any grid): every run, or the "
+                         "first with --chain")
     ap.add_argument("--domain", nargs=3, type=float, default=[-11.0, 19.0, 11.0],
                     metavar=("X_MIN", "X_MAX", "Y_MAX"), help="units of a")
     ap.add_argument("--set", action="append", default=[], type=spec_option,
@@ -144,30 +170,41 @@ def main(argv=None) -> int:
     a = spec.a
     name = f"thin_film_region{'_' + args.tag if args.tag else ''}"
     record = {"spec": args.spec, "set": dict(args.set), "domain_over_a": args.domain,
+              "start": args.start or None,
               "transits": args.transits, "balance": args.balance, "chain": args.chain,
               "tolerance": args.tolerance if args.balance else None,
+              "window": args.window if args.balance else None,
               "transit_s": spec.transit_time, "runs": []}
-    start = None
+    initial = load_state(Path(args.start)) if args.start else None
+    start = initial
     print(f"{'cell/a':>7} {'Co':>5} {'film':>5} {'recede':>6} {'transits':>8} {'state':>5} "
           f"{'inlet/a':>8} "
           f"{'width/a':>8} {'length/a':>8} {'rear/a':>7} {'oil nl':>8} {'out/in':>7} "
           f"{'wall s':>7}", flush=True)
-    for receding, ff, courant, cell in itertools.product(args.receding, args.film_factor,
-                                                          args.courant, args.cells):
-        prob = problem_from_spec(spec, gap, cell, tuple(args.domain), ff, receding)
+    for position, receding, nl, ff, courant, cell in itertools.product(
+            args.meniscus, args.receding, args.normal_length, args.film_factor, args.courant,
+            args.cells):
+        prob = problem_from_spec(spec, gap, cell, tuple(args.domain), ff, receding, nl,
+                                 position)
         t0 = time.perf_counter()
         sol = solve_thin_film(prob, transits_max=args.transits,
                               tolerance=args.tolerance if args.balance else 0.0,
                               transit_length=spec.run.transit_length * a,
-                              start=start if args.chain else None, courant=courant)
+                              start=start if args.chain else initial,
+                              courant=courant, window=args.window)
         wall = time.perf_counter() - t0
         m = sol.metrics(a)
-        label = f"{cell:g} a, Co {courant:g}, {ff:g} LL, {receding}"
-        state = WORK / (args.tag or "default") / f"{cell:g}_{courant:g}_{ff:g}_{receding}.npz"
+        label = f"{cell:g} a, Co {courant:g}, {ff:g} LL, {receding}" + (
+            f", normal {nl:g} a" if nl is not None else "") + f", {position}"
+        state = WORK / (args.tag or "default") / (
+            f"{cell:g}_{courant:g}_{ff:g}_{receding}" + (f"_n{nl:g}" if nl is not None else "")
+            + f"_{position}.npz")
         save_state(sol, state)
         record["runs"].append({"index": len(record["runs"]), "label": label,
                                "cell_over_a": cell, "courant": courant, "film_factor": ff,
-                               "receding_meniscus": receding, "wall_s": wall, "metrics": m,
+                               "receding_meniscus": receding, "normal_length_over_a": nl,
+                               "meniscus_position": position,
+                               "wall_s": wall, "metrics": m,
                                "history": sol.history, "state": str(state)})
         save(f"{name}.json", record)
         start = sol
