@@ -416,16 +416,14 @@ class _Operators:
 
     def menisci(self, flooded: np.ndarray, c: np.ndarray) -> "_Faces":
         """Each face between a flooded cell and an open one: the flooded cell's conductance
-        to the meniscus and the meniscus's pressure, for x faces and y faces. Sub-cell: the
-        meniscus sits theta = 1/2 + phi cells from the flooded cell's centre, phi the open
-        cell's bulk oil over its room for it, at the gap there (linear between the two
-        centres); conductance g / theta. Cell: at the open cell's centre, g and its pcap."""
+        to the meniscus and the meniscus's pressure, for x faces and y faces. The meniscus
+        sits theta cells from the flooded cell's centre, at the gap there (linear between
+        the two centres), conductance g / theta: sub-cell, theta = 1/2 + the open cell's
+        fill; cell, theta = 1 (the open cell's centre). Its pressure: Young-Laplace's,
+        times the receding pull."""
         pcap = self.meniscus_pressure(flooded)
-        if not self.sub_cell:
-            return _Faces(self.gx, self.gy, np.where(flooded[:, 1:], pcap[:, :-1], pcap[:, 1:]),
-                          np.where(flooded[1:], pcap[:-1], pcap[1:]), self.h[:, 1:])
         factor = np.where(self.island, 1.0, pcap / np.where(self.island, 1.0, self.pcap))
-        theta = 0.5 + self.fill(c)
+        theta = 0.5 + self.fill(c) if self.sub_cell else np.ones_like(c)
         out = []
         for axis, g in ((1, self.gx), (0, self.gy)):
             lo = [slice(None), slice(None)]
@@ -437,8 +435,9 @@ class _Operators:
             h_f = np.where(hi_open, self.h[lo], self.h[hi])
             h_o = np.where(hi_open, self.h[hi], self.h[lo])
             h_m = h_f + th * (h_o - h_f)
-            f = np.where(hi_open, factor[hi], factor[lo])
-            out += [g / th, -f * self.young_laplace / np.where(h_m > 0, h_m, np.inf), h_m]
+            safe = np.where(h_m > 0, h_m, 1.0)          # faces on the island carry nothing
+            suction = np.where(hi_open, factor[hi], factor[lo]) * self.young_laplace / safe
+            out += [g / th, np.where(h_m > 0, -suction, 0.0), h_m]
         return _Faces(out[0], out[3], out[1], out[4], out[2])
 
     def pressure(self, flooded: np.ndarray, c: np.ndarray, dt: float,
