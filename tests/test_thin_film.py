@@ -53,6 +53,10 @@ def test_strip_menisci_sit_where_the_1d_theory_puts_them(receding):
     xs = sol.grid.x[row]
     assert abs(xs[-1] + cell / 2 - x_rear) <= cell
     assert abs(xs[0] - cell / 2 - x_in) <= cell
+    # read inside their open cells (sub-cell menisci), within a quarter and a half cell
+    first, last = np.nonzero(row)[0][[0, -1]]
+    assert abs(xs[0] - cell / 2 - cell * sol.fill[0, first - 1] - x_in) <= 0.25 * cell
+    assert abs(xs[-1] + cell / 2 + cell * sol.fill[0, last + 1] - x_rear) <= 0.5 * cell
     assert abs(sol.flux_out / sol.flux_in - 1.0) < 0.02
     assert sol.mass_balance_error < 1e-9
 
