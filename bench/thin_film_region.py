@@ -78,6 +78,15 @@ def _receding(text: str) -> str | float:
             f"--receding {text!r}: 'static', 'bretherton' or a factor in [0.5, 2]") from None
 
 
+def _progress(a: float, transit_s: float):
+    """A line on stderr for each transit of a run: its oil, outflow and width."""
+    def show(rec: dict) -> None:
+        print(f"  transit {rec['time_s'] / transit_s:6.1f}: oil {rec['oil_m3'] * 2e12:7.1f} nl, "
+              f"out / in {rec['outflow_over_supply']:5.3f}, width {rec['width_m'] / a:6.2f} a",
+              file=sys.stderr, flush=True)
+    return show
+
+
 def save_state(sol: ThinFilmSolution, path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(path, x=sol.grid.x, y=sol.grid.y, h=sol.grid.h, flooded=sol.flooded,
@@ -191,7 +200,8 @@ def main(argv=None) -> int:
                               tolerance=args.tolerance if args.balance else 0.0,
                               transit_length=spec.run.transit_length * a,
                               start=start if args.chain else initial,
-                              courant=courant, window=args.window)
+                              courant=courant, window=args.window,
+                              progress=_progress(a, spec.transit_time))
         wall = time.perf_counter() - t0
         m = sol.metrics(a)
         label = f"{cell:g} a, Co {courant:g}, {ff:g} LL, {receding}" + (

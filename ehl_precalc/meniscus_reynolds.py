@@ -10,18 +10,23 @@ On a uniform grid of square cells over the half domain y >= 0 (symmetry on y = 0
 holds oil c [m] per unit area, 0 <= c <= h. A full cell (c = h) is **flooded**: its pressure p
 is unknown and it neither gains nor loses oil. Any other cell is **open**: air in the middle of
 the gap, the oil as layers on the walls, and, next to the flooded region, the bulk of the
-meniscus; its pressure is the meniscus's, p_cap = -2 sigma cos(theta) / h (gauge against the
-ambient air). The fluxes through a face, lo -> hi:
+meniscus. The meniscus sits in the open cell as far as that bulk fills it (its **fill**, the
+oil beyond the layers the walls carry, over the room for it: the supply's layers ahead of
+the contact, the films elsewhere), theta = 1/2 + fill cells from the flooded cell's centre,
+and its pressure is Young-Laplace's at the gap h_m there, p_cap = -2 sigma cos(theta) / h_m
+(gauge against the ambient air); so the meniscus, its pressure and the flooded cell's
+conductance to it move smoothly as a cell fills (``meniscus_position``). The fluxes
+through a face, lo -> hi:
 
 - flooded to flooded: Couette u h (x faces) and Poiseuille -h^3 / (12 eta) dp/dn;
-- flooded to open or open to flooded: the same, with the open cell at p_cap (the meniscus
-  sits between them), except that from an open cell into a flooded one downstream the walls
+- flooded to open or open to flooded: the same, Poiseuille over the distance theta to the
+  meniscus at p_cap, except that from an open cell into a flooded one downstream the walls
   carry what the open cell holds, u c, in place of u h;
 - open to open (x faces only): the walls carry the layers on, u c, but a cell touching the
   flooded region holds bulk oil that a receding meniscus does not give up whole: it passes
   at most u f, with f = 2 * 1.34 Ca^(2/3) (h / 2) / (1 + 3.35 Ca^(2/3)) Landau-Levich's
   films on both walls (Ca = eta u / sigma; Aussillous and Quere's fit) times
-  ``film_factor``;
+  ``film_factor``, laid of the gap at the receding meniscus;
 - none through the island (the unmeshed contact, as in the CFD cases) or across y = 0; the
   supply u * (layers) enters the first column on the track; the last column and the side
   are open to the ambient air.
@@ -30,8 +35,10 @@ It is marched in time to a steady state: each step solves p on the flooded cells
 scipy; a flooded cell's outflow is zero, or returns oil it holds beyond its gap), moves the
 oil, and an open cell that fills becomes flooded while a flooded cell that the region drains
 (it draws more from an open neighbour than that holds: air comes in) becomes open. The oil is
-conserved to round-off; the step is a quarter of a cell's transit at u (the oil held after
-10 nominal transits moves 0.3 % from there to an eighth, 3.5 % to a half).
+conserved to round-off; the step is a quarter of a cell's transit at u (the nominal balance
+holds 173.6 / 173.7 / 173.7 nl at a quarter, an eighth and a sixteenth; with the menisci at
+the open cells' centres it moved by 6-16 % at each halving of the step, as they jumped a
+cell at a time).
 
 This is the mass-conserving cavitation model of lubrication (Elrod-Adams; Jakobsson,
 Floberg and Olsson's conditions) with two changes that make it a model of this flow: the
