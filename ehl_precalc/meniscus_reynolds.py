@@ -312,7 +312,7 @@ def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,
         X, Y = np.meshgrid(grid.x, grid.y)
         c = np.where((np.hypot(X, Y) < prob.initial_radius) & ~grid.island, h, 0.0)
     else:
-        c = np.minimum(_interpolate(start, grid) * h, h)
+        c = _interpolate(start, grid) * h              # a full cell may hold more: it returns it
     dt = courant * d / u
     transit = (transit_length or (prob.x_range[1] - prob.x_range[0])) / u
     steps_per_transit = max(1, int(round(transit / dt)))

@@ -262,3 +262,19 @@ def test_a_case_spec_becomes_the_same_problem():
     with pytest.raises(ValueError, match="supply.mode = 'submerged'"):
         problem_from_spec(make_case_spec({"supply": {"mode": "submerged"}}), ball_gap, 0.25,
                           (-10.0, 18.0, 9.0))
+
+
+def test_a_saved_state_starts_a_run_where_it_left_off(tmp_path):
+    """bench/thin_film_region.py --start: a state written by a run, read back, starts the
+    next one with the same oil in the same cells, on its grid or a finer one."""
+    from bench.thin_film_region import load_state, save_state
+
+    sol = solve_thin_film(ball_problem(), transits_max=2, tolerance=0.0, transit_length=10 * A)
+    save_state(sol, tmp_path / "state.npz")
+    start = load_state(tmp_path / "state.npz")
+    again = solve_thin_film(ball_problem(), transits_max=0, start=start)
+    np.testing.assert_array_equal(again.flooded, sol.flooded)
+    np.testing.assert_allclose(again.content, sol.content, rtol=1e-12, atol=0)
+    finer = solve_thin_film(ball_problem(cell=0.2 * A), transits_max=0, start=start)
+    assert finer.metrics(A)["oil_volume_m3"] == pytest.approx(sol.metrics(A)["oil_volume_m3"],
+                                                              rel=0.05)
