@@ -111,22 +111,23 @@ def plot_menisci(records: list[dict], a: float, out: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(8, 3.4))
+    fig, ax = plt.subplots(figsize=(11, 3.6))
     for rec in records:
         d = np.load(rec["state"])
         region = d["flooded"].astype(float)
+        color = plt.cm.viridis(0.9 * rec["index"] / max(len(records) - 1, 1))
         ax.contour(d["x"] / a, d["y"] / a, region, levels=[0.5], linewidths=1.2,
-                   colors=[plt.cm.viridis(rec["index"] / max(len(records) - 1, 1))])
-        ax.plot([], [], color=plt.cm.viridis(rec["index"] / max(len(records) - 1, 1)),
+                   colors=[color])
+        ax.plot([], [], color=color,
                 label=f"{rec['label']}: width {rec['metrics']['flooded_width_over_a']:.2f} a")
     ax.add_patch(plt.Circle((0, 0), 1.0, color="0.3"))
     ax.set_aspect("equal")
     ax.set_xlabel("x / a (rolling ->)")
     ax.set_ylabel("y / a")
     ax.set_title("thin-film model: flooded region (half domain)")
-    ax.legend(fontsize=7, loc="lower left")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
-    fig.savefig(out, dpi=130)
+    fig.savefig(out, dpi=130, bbox_inches="tight")
 
 
 def main(argv=None) -> int:
