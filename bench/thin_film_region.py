@@ -141,9 +141,10 @@ def main(argv=None) -> int:
     ap.add_argument("--receding", nargs="+", default=["static"], type=_receding,
                     help="the receding meniscus's capillary pressure: static, bretherton or "
                          "a factor on the static one")
-    ap.add_argument("--normal-length", nargs="+", type=float, default=[None],
+    ap.add_argument("--normal-length", nargs="+", type=float, default=[0.3],
                     help="units of a: the smoothing of the region for the receding "
-                         "meniscus's normal (default 1.5 cells)")
+                         "meniscus's normal (0.3-0.6 a give the same region; 0.15 a and "
+                         "1.5 cells of 0.1 a shed it)")
     ap.add_argument("--meniscus", nargs="+", default=["sub-cell"], choices=["sub-cell", "cell"],
                     help="where a meniscus sits in its open cell (ThinFilmProblem."
                          "meniscus_position)")
@@ -206,9 +207,10 @@ def main(argv=None) -> int:
         wall = time.perf_counter() - t0
         m = sol.metrics(a)
         label = f"{cell:g} a, Co {courant:g}, {ff:g} LL, {receding}" + (
-            f", normal {nl:g} a" if nl is not None else "") + f", {position}"
+            f", normal {nl:g} a" if receding != "static" else "") + f", {position}"
         state = WORK / (args.tag or "default") / (
-            f"{cell:g}_{courant:g}_{ff:g}_{receding}" + (f"_n{nl:g}" if nl is not None else "")
+            f"{cell:g}_{courant:g}_{ff:g}_{receding}"
+            + (f"_n{nl:g}" if receding != "static" else "")
             + f"_{position}.npz")
         save_state(sol, state)
         record["runs"].append({"index": len(record["runs"]), "label": label,
