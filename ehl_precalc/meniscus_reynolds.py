@@ -431,7 +431,7 @@ class _Operators:
         pcap = self.meniscus_pressure(flooded)
         factor = np.where(self.island, 1.0, pcap / np.where(self.island, 1.0, self.pcap))
         theta = 0.5 + self.fill(c) if self.sub_cell else np.ones_like(c)
-        out = []
+        per_axis = {}
         for axis, g in ((1, self.gx), (0, self.gy)):
             lo = [slice(None), slice(None)]
             hi = [slice(None), slice(None)]
@@ -444,8 +444,9 @@ class _Operators:
             h_m = h_f + th * (h_o - h_f)
             safe = np.where(h_m > 0, h_m, 1.0)          # faces on the island carry nothing
             suction = np.where(hi_open, factor[hi], factor[lo]) * self.young_laplace / safe
-            out += [g / th, np.where(h_m > 0, -suction, 0.0), h_m]
-        return _Faces(out[0], out[3], out[1], out[4], out[2])
+            per_axis[axis] = (g / th, np.where(h_m > 0, -suction, 0.0), h_m)
+        (gx, px, hx), (gy, py, _) = per_axis[1], per_axis[0]
+        return _Faces(gx=gx, gy=gy, px=px, py=py, hx=hx)
 
     def pressure(self, flooded: np.ndarray, c: np.ndarray, dt: float,
                  faces: "_Faces") -> np.ndarray:
