@@ -401,19 +401,24 @@ class _Operators:
         self.layers = np.where(ahead, np.maximum(prob.supply * on_track[:, None], self.cap),
                                self.cap)
 
-    def meniscus_pressure(self, flooded: np.ndarray) -> np.ndarray:
-        """The capillary pressure of every open cell [Pa]: the static one, times
+    def pull_factor(self, flooded: np.ndarray) -> np.ndarray | float:
+        """The receding pull on every cell's meniscus, a factor on the static pressure:
         1 + (pull - 1) n^(2/3) where the walls leave the meniscus at u n (n: the x part of its
         outward normal, from the flooded cells smoothed over ``normal_length``; Ca n is the
         capillary number of the films it lays), so that a meniscus at an angle to u is not
-        left to the staircase of the cells."""
+        left to the staircase of the cells; 1 with static menisci."""
         if self.pull == 1.0:
-            return self.pcap
+            return 1.0
         phi = ndimage.gaussian_filter(flooded.astype(float), self.normal_sigma,
                                       mode="nearest")
         gy, gx = np.gradient(phi)
         n = np.clip(-gx / np.maximum(np.hypot(gx, gy), 1e-12), 0.0, 1.0)
-        return self.pcap * (1.0 + (self.pull - 1.0) * n ** (2.0 / 3.0))
+        return 1.0 + (self.pull - 1.0) * n ** (2.0 / 3.0)
+
+    def meniscus_pressure(self, flooded: np.ndarray) -> np.ndarray:
+        """The capillary pressure of a meniscus at every open cell's centre [Pa]: the static
+        one times the receding pull."""
+        return self.pcap * self.pull_factor(flooded)
 
     def fill(self, c: np.ndarray) -> np.ndarray:
         """How far into each cell a meniscus beside it reaches: the cell's bulk oil (beyond
@@ -428,8 +433,7 @@ class _Operators:
         the two centres), conductance g / theta: sub-cell, theta = 1/2 + the open cell's
         fill; cell, theta = 1 (the open cell's centre). Its pressure: Young-Laplace's,
         times the receding pull."""
-        pcap = self.meniscus_pressure(flooded)
-        factor = np.where(self.island, 1.0, pcap / np.where(self.island, 1.0, self.pcap))
+        factor = np.broadcast_to(self.pull_factor(flooded), flooded.shape)
         theta = 0.5 + self.fill(c) if self.sub_cell else np.ones_like(c)
         per_axis = {}
         for axis, g in ((1, self.gx), (0, self.gy)):
