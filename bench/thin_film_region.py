@@ -79,10 +79,12 @@ def _receding(text: str) -> str | float:
 
 
 def _progress(a: float, transit_s: float):
-    """A line on stderr for each transit of a run: its oil, outflow and width."""
+    """A line on stderr for each transit of a run: its oil, outflow, width and the cells
+    that ran dry within a step."""
     def show(rec: dict) -> None:
         print(f"  transit {rec['time_s'] / transit_s:6.1f}: oil {rec['oil_m3'] * 2e12:7.1f} nl, "
-              f"out / in {rec['outflow_over_supply']:5.3f}, width {rec['width_m'] / a:6.2f} a",
+              f"out / in {rec['outflow_over_supply']:5.3f}, width {rec['width_m'] / a:6.2f} a, "
+              f"{rec['cells_opened_dry']} cells ran dry",
               file=sys.stderr, flush=True)
     return show
 

@@ -212,7 +212,9 @@ class ThinFilmSolution:
     """The state at the end of a march: the grid, p [Pa] (NaN where open), the oil c [m],
     ``flooded`` (bool, ny x nx), the time marched [s], the supply and the flux leaving the
     domain [m3/s] over the last transit (half domain), ``steady``, the record of each transit
-    (time, the region's oil [m3, half domain], flooded cells, outflow / supply, width [m])
+    (time, the region's oil [m3, half domain], flooded cells, outflow / supply, width [m],
+    the flooded cells that ran dry within a step: a sound march opens a few at most, and
+    hundreds mean the step or the pull's normal drives the menisci unstably)
     and the oil mass balance error over the march (the oil gained less what came in and
     went out, over what came in); with sub-cell menisci, ``fill``: how far into each open
     cell its meniscus reaches (0-1)."""
@@ -319,6 +321,7 @@ def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,
     q_in = float(ops.q_supply.sum())
     oil_start = float(c.sum()) * d * d
     oil_in = oil_out = out_this_transit = 0.0
+    dry_this_transit = 0
     history: list[dict] = []
     steady = False
     step = 0
@@ -332,6 +335,7 @@ def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,
         oil_in += q_in * dt
         oil_out += q_out * dt
         out_this_transit += q_out * dt
+        dry_this_transit += int(opened.sum())
         if step % steps_per_transit:
             continue
         region = connected_region(flooded, grid.island)
@@ -340,9 +344,10 @@ def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,
                "flooded_cells": int(region.sum()),
                "outflow_over_supply": out_this_transit / (q_in * steps_per_transit * dt)
                if q_in > 0 else 0.0,
-               "width_m": float(2 * (grid.y[rows[-1]] + d / 2)) if rows.size else 0.0}
+               "width_m": float(2 * (grid.y[rows[-1]] + d / 2)) if rows.size else 0.0,
+               "cells_opened_dry": dry_this_transit}
         history.append(rec)
-        out_this_transit = 0.0
+        out_this_transit, dry_this_transit = 0.0, 0
         if progress:
             progress(rec)
         if tolerance > 0 and len(history) > window:
