@@ -11,8 +11,9 @@ after every run (atomically), the states to ``runs/bench/thin_film/TAG/`` and, w
 
     python bench/thin_film_region.py [SPEC] [--cells 0.2 0.1 0.05] [--courant 0.25 ...]
         [--film-factor 1 ...] [--receding static bretherton 1.05 ...] [--transits 10]
-        [--normal-length 0.3 ...] [--meniscus sub-cell cell] [--balance [--tolerance 0.01] [--window 5]] [--chain]
-        [--start STATE.npz] [--domain -11 19 11]
+        [--normal-length 0.3 ...] [--meniscus sub-cell cell]
+        [--balance [--tolerance 0.01] [--window 5]] [--chain] [--start STATE.npz]
+        [--domain -11 19 11]
         [--set KEY=VALUE ...] [--tag NAME] [--plot FILE.png]
     python bench/thin_film_region.py --plot FILE.png --plot-records RECORD.json ...
 """

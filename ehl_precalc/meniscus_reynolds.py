@@ -420,11 +420,6 @@ class _Operators:
         n = np.clip(-gx / np.maximum(np.hypot(gx, gy), 1e-12), 0.0, 1.0)
         return 1.0 + (self.pull - 1.0) * n ** (2.0 / 3.0)
 
-    def meniscus_pressure(self, flooded: np.ndarray) -> np.ndarray:
-        """The capillary pressure of a meniscus at every open cell's centre [Pa]: the static
-        one times the receding pull."""
-        return self.pcap * self.pull_factor(flooded)
-
     def fill(self, c: np.ndarray) -> np.ndarray:
         """How far into each cell a meniscus beside it reaches: the cell's bulk oil (beyond
         the walls' layers) over its room for it, 0-1."""
