@@ -1,0 +1,187 @@
+"""An advancing meniscus on dry walls, on a strip: does its contact line converge in the cells?
+
+Outside the supply track the walls come into the flooded region dry: on the front of its
+sides they advance into the oil with a moving contact line. With no slip at the wall and a
+static contact angle, the viscous stress at a moving contact line is singular, and a volume of
+fluid method cuts it off at the cells: the apparent angle a gap away follows Cox-Voinov,
+theta_app^3 = theta_s^3 + 9 Ca ln(L / lambda), with a numerical slip lambda of the order of a
+cell, so it grows with every halving of the cells by the same step and never converges (Afkhami,
+Zaleski and Bussmann 2009, J. Comput. Phys. 228, 5370). This bench asks whether the cases'
+meshes show that, on the least model that has it.
+
+A strip one cell wide (empty sides) along y = 0 of the nominal gap, x from ``--x-in`` to
+``--x-out``, with both walls rolling at -u (towards the narrow end) and an oil reservoir at
+ambient pressure at x_in, starts as a bridge of oil up to ``--bridge``. The walls come in dry
+from x_out and drag the oil towards the reservoir; the meniscus's suction draws it back. At
+rest on the walls' flux the bridge's pressure falls by int 12 eta u / h^2 dx from the reservoir
+to the meniscus, where it equals the jump sigma (cos theta + cos(theta + beta)) / h (beta: the
+ball's slope there). So where the meniscus stands gives the apparent angle theta_app it has a
+gap's size away from the wall; the bench prints both, per in-plane cell size dx (a) and level
+(its wall layers), with the static angle's and Cox-Voinov's positions.
+
+    python bench/contact_line_strip.py [--dx 0.2 0.1 0.05 0.025] [--levels fine]
+        [--x-in 4] [--x-out 10] [--bridge 6.3] [--time 0.3] [--set KEY=VALUE ...]
+        [--work DIR] [--reuse] [--save NAME.json]
+"""
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import shutil
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.integrate import cumulative_trapezoid
+from scipy.optimize import brentq
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from foamlib import FoamFieldFile  # noqa: E402
+
+from bench.common import save, spec_option  # noqa: E402
+from bench.film_deposition import measure, strip_mesh, write_strip_case  # noqa: E402
+from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
+from generator.gap_source import load_gap  # noqa: E402
+from runs.foam_runtime import FoamRuntime  # noqa: E402
+
+
+def reverse_walls(spec: CaseSpec, case: Path) -> None:
+    """Turn the film strip written by ``write_strip_case`` into the advancing one: both walls
+    at -u, and the supply patch an oil reservoir at ambient pressure (oil in, anything out)."""
+    u = spec.wall_speed
+    with FoamFieldFile(case / "0.orig" / "U") as f:
+        f.boundary_field["disc"]["value"] = np.array([-u, 0.0, 0.0])
+        f.boundary_field["ball"]["omega"] = u / spec.contact.radius
+        f.boundary_field["supply"] = {"type": "pressureInletOutletVelocity",
+                                      "value": np.zeros(3)}
+    with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
+        f.boundary_field["supply"] = {"type": "totalPressure", "p0": 0.0, "value": 0.0}
+    with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
+        f.boundary_field["supply"] = {"type": "inletOutlet", "inletValue": 1.0, "value": 1.0}
+    shutil.rmtree(case / "0")
+    shutil.copytree(case / "0.orig", case / "0")
+
+
+def balance(spec: CaseSpec, gap, x_in: float, x_out: float):
+    """The bridge's balance on y = 0: x (m), gap h (m), its slope, and the pressure the walls'
+    drag takes off from the reservoir to each x (Pa, positive), int 12 eta u / h^2 dx."""
+    x = np.linspace(x_in, x_out, 4001)
+    h = gap(x, np.zeros_like(x))
+    drop = cumulative_trapezoid(12.0 * spec.oil_viscosity * spec.speed / h**2, x, initial=0.0)
+    return x, h, np.gradient(h, x), drop
+
+
+def meniscus_for_angle(spec: CaseSpec, table, theta_deg: float) -> float:
+    """Where (m) the bridge's meniscus stands at rest for the apparent angle theta (deg)."""
+    x, h, slope, drop = table
+    t = np.radians(theta_deg)
+    jump = spec.physics.surface_tension * (np.cos(t) + np.cos(t + np.arctan(slope))) / h
+    k = np.flatnonzero(drop >= jump)
+    return float(x[k[0]]) if len(k) else float("nan")
+
+
+def angle_at_meniscus(spec: CaseSpec, table, x_m: float) -> float:
+    """The apparent angle (deg) that puts the meniscus at rest at x_m (m); NaN outside 0-90."""
+    x, h, slope, drop = table
+    hm, beta, dp = (np.interp(x_m, x, v) for v in (h, np.arctan(slope), drop))
+    sigma = spec.physics.surface_tension
+
+    def g(t: float) -> float:
+        return sigma * (np.cos(t) + np.cos(t + beta)) / hm - dp
+    lo, hi = 0.0, np.pi / 2 - beta
+    return float(np.degrees(brentq(g, lo, hi))) if g(lo) * g(hi) < 0 else float("nan")
+
+
+def cox_voinov(theta_s_deg: float, ca: float, ratio: float) -> float:
+    """Cox-Voinov's apparent angle (deg) for the static angle theta_s, the capillary number of
+    the contact line's speed and the ratio of the macroscopic length to the slip length."""
+    t3 = np.radians(theta_s_deg) ** 3 + 9.0 * ca * np.log(ratio)
+    return float(np.degrees(np.cbrt(max(t3, 0.0))))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--dx", nargs="+", type=float, default=[0.2, 0.1, 0.05, 0.025],
+                    help="in-plane cell sizes [a]")
+    ap.add_argument("--levels", nargs="+", default=["fine"],
+                    help="levels whose wall layers and capillary safety are used")
+    ap.add_argument("--x-in", type=float, default=4.0, help="oil reservoir at x = X a")
+    ap.add_argument("--x-out", type=float, default=10.0, help="dry walls enter at x = X a")
+    ap.add_argument("--bridge", type=float, default=6.3, help="oil at t = 0 up to x = X a")
+    ap.add_argument("--time", type=float, default=0.3, help="simulated time [s]")
+    ap.add_argument("--writes", type=int, default=30, help="writes over the run")
+    ap.add_argument("--set", action="append", default=[], type=spec_option,
+                    metavar="KEY=VALUE", help="any other spec option (e.g. mesh.n_layers=20)")
+    ap.add_argument("--work", type=Path, default=ROOT / "runs" / "bench" / "contact_line")
+    ap.add_argument("--reuse", action="store_true",
+                    help="measure a case already run to --time in --work instead of re-running")
+    ap.add_argument("--save", help="record name under bench/results/ (written after each case)")
+    ap.add_argument("--note", default="")
+    args = ap.parse_args(argv)
+    if not args.time > 0:
+        ap.error(f"--time: {args.time} (valid range > 0)")
+    if not 1.5 <= args.x_in < args.bridge < args.x_out:
+        ap.error(f"--x-in {args.x_in}, --bridge {args.bridge}, --x-out {args.x_out}: need "
+                 "1.5 <= x_in < bridge < x_out (a)")
+    runtime = FoamRuntime.from_environment()
+    results = []
+    for level, dx_a in itertools.product(args.levels, args.dx):
+        spec = make_case_spec({"mesh": {"resolution": level}}, **dict(args.set))
+        gap, _ = load_gap(spec.contact)
+        a = spec.a
+        ca = spec.oil_viscosity * spec.speed / spec.physics.surface_tension
+        table = balance(spec, gap, args.x_in * a, args.x_out * a)
+        mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
+        case = args.work / (f"{level}_dx{dx_a:g}_x{args.x_in:g}-{args.x_out:g}" + "".join(
+            f"_{k.split('.')[-1]}{v}" for k, v in args.set))
+        record = case / "run.json"
+        if args.reuse and record.exists() and json.loads(record.read_text())["end_time_s"] == args.time:
+            run = json.loads(record.read_text())
+        else:
+            dt = write_strip_case(spec, case, mesh, args.bridge * a, 0.0, dx_a * a, args.time,
+                                  args.time / args.writes)
+            reverse_walls(spec, case)
+            t0 = time.perf_counter()
+            proc = runtime.run("interFoam", cwd=case, log_path=case / "log.interFoam",
+                               check=False)
+            run = {"max_delta_t_s": dt, "end_time_s": args.time,
+                   "status": "ok" if proc.returncode == 0 else "failed",
+                   "wall_s": time.perf_counter() - t0, "steps": proc.stdout.count("\nTime = ")}
+            record.write_text(json.dumps(run) + "\n")
+        rows = measure(case, mesh, a, args.x_out * a)
+        for r in rows:
+            r["apparent_angle_deg"] = angle_at_meniscus(spec, table, r["x_rear_over_a"] * a)
+        late = [r for r in rows if r["t_s"] >= 0.6 * args.time]
+        x_m = float(np.median([r["x_rear_over_a"] for r in late])) if late else float("nan")
+        drift = (late[-1]["x_rear_over_a"] - late[0]["x_rear_over_a"]) if late else float("nan")
+        theta_app = angle_at_meniscus(spec, table, x_m * a)
+        h_m = float(np.interp(x_m * a, table[0], table[1]))
+        result = {"level": level, "dx_over_a": dx_a, "dx_m": dx_a * a, "cells": mesh.n_cells,
+                  **run, "capillary_number": ca,
+                  "meniscus_late_median_over_a": x_m, "meniscus_late_drift_over_a": drift,
+                  "gap_at_meniscus_m": h_m, "apparent_angle_deg": theta_app,
+                  "meniscus_static_angle_over_a":
+                      meniscus_for_angle(spec, table, spec.physics.contact_angle) / a,
+                  "options": dict(args.set), "writes": rows}
+        results.append(result)
+        print(f"{level:>7} dx {dx_a:6.4g} a ({dx_a * a * 1e6:5.1f} um) {mesh.n_cells:6d} cells "
+              f"{result['steps']:6d} steps {result['wall_s']:6.0f} s {result['status']}: "
+              f"meniscus {x_m:6.3f} a (drift {drift:+.3f} a over the last 40 %), gap "
+              f"{h_m * 1e6:5.1f} um, apparent angle {theta_app:5.1f} deg (static "
+              f"{spec.physics.contact_angle:g} deg: {result['meniscus_static_angle_over_a']:.3f} a;"
+              f" Cox-Voinov at L/lambda = h/dx: "
+              f"{cox_voinov(spec.physics.contact_angle, ca, h_m / (dx_a * a)):5.1f} deg)",
+              flush=True)
+        if args.save:   # after every case: an interrupted sweep keeps what it measured
+            save(args.save, {"note": args.note,
+                             "args": {k: str(v) for k, v in vars(args).items()},
+                             "rows": results})
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
