@@ -11,7 +11,7 @@ after every run (atomically), the states to ``runs/bench/thin_film/TAG/`` and, w
 
     python bench/thin_film_region.py [SPEC] [--cells 0.2 0.1 0.05] [--courant 0.25 ...]
         [--film-factor 1 ...] [--receding static bretherton 1.05 ...] [--transits 10]
-        [--normal-length 0.3 ...] [--meniscus sub-cell cell]
+        [--advancing static 47 ...] [--normal-length 0.3 ...] [--meniscus sub-cell cell]
         [--balance [--tolerance 0.01] [--window 5]] [--chain] [--start STATE.npz]
         [--domain -11 19 11]
         [--set KEY=VALUE ...] [--tag NAME] [--plot FILE.png]
@@ -43,11 +43,12 @@ WORK = ROOT / "runs" / "bench" / "thin_film"
 def problem_from_spec(spec: CaseSpec, gap, cell: float, domain: tuple[float, float, float],
                       film_factor: float = 1.0, receding: str | float = "static",
                       normal_length: float | None = None,
-                      meniscus_position: str = "sub-cell") -> ThinFilmProblem:
+                      meniscus_position: str = "sub-cell",
+                      advancing_angle: float | None = None) -> ThinFilmProblem:
     """The thin-film problem of a case spec: its contact, oil, wetting and supply ("layers":
     both layers on the track; "flooded": the whole inlet gap on the track), ``cell``,
     ``domain`` = (x_min, x_max, y_max) and ``normal_length`` (None: 1.5 cells) in units of
-    a."""
+    a, and the advancing menisci's apparent angle on dry walls (deg; None: the static one)."""
     a = spec.a
     sup = spec.supply
     supply = sup.disc_layer + sup.ball_layer
@@ -65,7 +66,18 @@ def problem_from_spec(spec: CaseSpec, gap, cell: float, domain: tuple[float, flo
         initial_radius=sup.initial_puddle * a, film_factor=film_factor,
         receding_meniscus=receding,
         normal_length=None if normal_length is None else normal_length * a,
-        meniscus_position=meniscus_position)
+        advancing_angle=advancing_angle, meniscus_position=meniscus_position)
+
+
+def _advancing(text: str) -> float | None:
+    """--advancing: 'static' (None) or an angle in degrees."""
+    if text == "static":
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"--advancing {text!r}: 'static' or an angle in degrees") from None
 
 
 def _receding(text: str) -> str | float:
@@ -144,6 +156,9 @@ def main(argv=None) -> int:
     ap.add_argument("--receding", nargs="+", default=["static"], type=_receding,
                     help="the receding meniscus's capillary pressure: static, bretherton or "
                          "a factor on the static one")
+    ap.add_argument("--advancing", nargs="+", default=[None], type=_advancing,
+                    help="the apparent angle (deg) of menisci advancing onto dry walls (off "
+                         "the track), or static (the static angle)")
     ap.add_argument("--normal-length", nargs="+", type=float, default=[0.3],
                     help="units of a: the smoothing of the region for the receding "
                          "meniscus's normal (0.3-0.6 a give the same region; 0.15 a and "
@@ -195,11 +210,12 @@ def main(argv=None) -> int:
           f"{'inlet/a':>8} "
           f"{'width/a':>8} {'length/a':>8} {'rear/a':>7} {'oil nl':>8} {'out/in':>7} "
           f"{'wall s':>7}", flush=True)
-    for position, receding, nl, ff, courant, cell in itertools.product(
-            args.meniscus, args.receding, args.normal_length, args.film_factor, args.courant,
-            args.cells):
+    for position, advancing, receding, nl, ff, courant, cell in itertools.product(
+            args.meniscus, args.advancing, args.receding, args.normal_length,
+            args.film_factor, args.courant, args.cells):
         prob = problem_from_spec(spec, gap, cell, tuple(args.domain), ff, receding, nl,
-                                 position)
+                                 position, advancing)
+        dynamic = receding != "static" or advancing is not None
         t0 = time.perf_counter()
         sol = solve_thin_film(prob, transits_max=args.transits,
                               tolerance=args.tolerance if args.balance else 0.0,
@@ -210,15 +226,18 @@ def main(argv=None) -> int:
         wall = time.perf_counter() - t0
         m = sol.metrics(a)
         label = f"{cell:g} a, Co {courant:g}, {ff:g} LL, {receding}" + (
-            f", normal {nl:g} a" if receding != "static" else "") + f", {position}"
+            f", advancing {advancing:g} deg" if advancing is not None else "") + (
+            f", normal {nl:g} a" if dynamic else "") + f", {position}"
         state = WORK / (args.tag or "default") / (
             f"{cell:g}_{courant:g}_{ff:g}_{receding}"
-            + (f"_n{nl:g}" if receding != "static" else "")
+            + (f"_adv{advancing:g}" if advancing is not None else "")
+            + (f"_n{nl:g}" if dynamic else "")
             + f"_{position}.npz")
         save_state(sol, state)
         record["runs"].append({"index": len(record["runs"]), "label": label,
                                "cell_over_a": cell, "courant": courant, "film_factor": ff,
                                "receding_meniscus": receding, "normal_length_over_a": nl,
+                               "advancing_angle_deg": advancing,
                                "meniscus_position": position,
                                "wall_s": wall, "metrics": m,
                                "history": sol.history, "state": str(state)})

@@ -49,9 +49,11 @@ pressure unless ``receding_meniscus`` gives the meniscus that the walls leave th
 pressure of one laying films ("bretherton": Park and Homsy's Hele-Shaw result) or a given
 factor on the static one (a number), falling off with the angle at which the walls leave it. It
 neglects the in-plane curvature of the meniscus (sigma / R beside 2 sigma / h: about 1 %),
-the air's pressure drop, gravity and inertia (Re ~ 0.01), the films' own orientation (a
-meniscus at an angle to u lays the films of the normal speed) and the dynamic contact angle
-of a meniscus advancing onto dry walls. SI units throughout.
+the air's pressure drop, gravity and inertia (Re ~ 0.01) and the films' own orientation (a
+meniscus at an angle to u lays the films of the normal speed). Off the track the walls come
+in dry and advance into the region with a moving contact line; ``advancing_angle`` gives
+such a meniscus its apparent (dynamic) angle, by default the static one. SI units
+throughout.
 """
 
 from __future__ import annotations
@@ -108,6 +110,14 @@ class ThinFilmProblem:
             let single cells flipping at the meniscus swing n, and n^(2/3) is steep at small
             n, by pressures the size of those that shape the region (tens of Pa): the rear
             meniscus drained within a step and shed its oil in streaks.
+        advancing_angle: the apparent contact angle [deg] of a meniscus the walls advance
+            into from dry ground (off the track, where no supply layer meets it), where they
+            meet it square on; None: the static angle. Cox-Voinov's theta^3 - theta_s^3 grows
+            with the capillary number of the contact line's speed, so at an angle theta^3
+            takes the share n of the step from theta_s^3 (n: the x part of the meniscus's
+            inward normal, from the region smoothed over ``normal_length``). A strip of
+            interFoam with dry walls advancing at the nominal Ca = 0.0058 converges in its
+            cells to 46-48 deg (``bench/contact_line_strip.py``).
         meniscus_position: where a meniscus sits in the open cell beside a flooded one:
             "sub-cell", as far into it as the cell's bulk oil fills it (its oil beyond the
             layers or films the walls carry, over the rest of its gap), so that the
@@ -133,6 +143,7 @@ class ThinFilmProblem:
     closed_side: bool = False
     receding_meniscus: Literal["static", "bretherton"] | float = "static"
     normal_length: float | None = None
+    advancing_angle: float | None = None
     meniscus_position: Literal["sub-cell", "cell"] = "sub-cell"
 
     def __post_init__(self) -> None:
@@ -158,6 +169,10 @@ class ThinFilmProblem:
                                       and not isinstance(self.receding_meniscus, bool)
                                       and 0.5 <= self.receding_meniscus <= 2.0),
                                   "'static', 'bretherton' or a factor in [0.5, 2]"),
+            "advancing_angle": (self.advancing_angle, self.advancing_angle is None
+                                or self.contact_angle <= self.advancing_angle < 90,
+                                f"None or in [{self.contact_angle:g}, 90) deg: the static "
+                                "angle up to a right angle"),
             "normal_length": (self.normal_length, self.normal_length is None
                               or 0.5 * self.cell <= self.normal_length <= span,
                               f"None or in [{0.5 * self.cell:.3g}, {span:.3g}] m: half a "
@@ -399,6 +414,9 @@ class _Operators:
         on_track = np.clip((prob.track_half_width - (grid.y - d / 2)) / d, 0.0, 1.0)
         self.q_supply = u * prob.supply * on_track * d  # into column 0 [m3/s]
         self.young_laplace = 2.0 * prob.surface_tension * cos_t   # pcap = -it / h [N/m]
+        self.theta_s = np.radians(prob.contact_angle)
+        self.theta_a = None if prob.advancing_angle is None else np.radians(prob.advancing_angle)
+        self.dry = 1.0 - on_track[:, None]             # walls coming in dry: off the track
         self.sub_cell = prob.meniscus_position == "sub-cell"
         # the oil an open cell holds as the walls' layers, not as meniscus: the supply's
         # layers ahead of the contact, the films elsewhere [m]
@@ -407,18 +425,26 @@ class _Operators:
                                self.cap)
 
     def pull_factor(self, flooded: np.ndarray) -> np.ndarray | float:
-        """The receding pull on every cell's meniscus, a factor on the static pressure:
-        1 + (pull - 1) n^(2/3) where the walls leave the meniscus at u n (n: the x part of its
-        outward normal, from the flooded cells smoothed over ``normal_length``; Ca n is the
-        capillary number of the films it lays), so that a meniscus at an angle to u is not
-        left to the staircase of the cells; 1 with static menisci."""
-        if self.pull == 1.0:
+        """The dynamic menisci's pressure on every cell, a factor on the static one. The
+        receding pull, 1 + (pull - 1) n^(2/3) where the walls leave the meniscus at u n (n:
+        the x part of its outward normal, from the flooded cells smoothed over
+        ``normal_length``; Ca n is the capillary number of the films it lays); the advancing
+        angle, cos(theta) / cos(theta_s) with theta^3 = theta_s^3 + m (theta_a^3 - theta_s^3)
+        where the walls come in dry (off the track) and run into the meniscus at u m. So a
+        meniscus at an angle to u is not left to the staircase of the cells; 1 with static
+        menisci."""
+        if self.pull == 1.0 and self.theta_a is None:
             return 1.0
         phi = ndimage.gaussian_filter(flooded.astype(float), self.normal_sigma,
                                       mode="nearest")
         gy, gx = np.gradient(phi)
-        n = np.clip(-gx / np.maximum(np.hypot(gx, gy), 1e-12), 0.0, 1.0)
-        return 1.0 + (self.pull - 1.0) * n ** (2.0 / 3.0)
+        nx = -gx / np.maximum(np.hypot(gx, gy), 1e-12)
+        factor = 1.0 + (self.pull - 1.0) * np.clip(nx, 0.0, 1.0) ** (2.0 / 3.0)
+        if self.theta_a is not None:
+            m = np.clip(-nx, 0.0, 1.0)
+            theta = np.cbrt(self.theta_s**3 + m * (self.theta_a**3 - self.theta_s**3))
+            factor = factor + self.dry * (np.cos(theta) / np.cos(self.theta_s) - 1.0)
+        return factor
 
     def fill(self, c: np.ndarray) -> np.ndarray:
         """How far into each cell a meniscus beside it reaches: the cell's bulk oil (beyond

@@ -147,6 +147,35 @@ def test_the_receding_pull_acts_where_the_walls_leave_the_meniscus(receding, pul
     assert np.all(static.pull_factor(flooded) == 1.0)
 
 
+def test_the_advancing_angle_acts_where_dry_walls_run_into_the_meniscus():
+    """Off the track the walls come in dry: straight ahead of a round region its menisci
+    take cos(theta_a) / cos(theta_s) of the static suction, beside it none of the change,
+    and in between Cox-Voinov's theta^3 at the share of the walls' speed into it; on the
+    track, where the supply's layers meet it, the static suction stays."""
+    from ehl_precalc.meniscus_reynolds import _Operators, _touches
+
+    prob = ball_problem(advancing_angle=47.0, cell=0.2 * A, track_half_width=2 * A)
+    grid = Grid.build(prob)
+    ops = _Operators(prob, grid)
+    X, Y = np.meshgrid(grid.x, grid.y)
+    flooded = (np.hypot(X, Y) < 6 * A) & ~grid.island
+    factor = ops.pull_factor(flooded)
+    edge = _touches(flooded) & ~grid.island
+    ts, ta = np.radians(THETA), np.radians(47.0)
+    assert factor[0, edge[0] & (grid.x < 0)] == pytest.approx(1.0)       # on the track
+    assert factor[0, edge[0] & (grid.x > 0)] == pytest.approx(1.0)       # the rear
+    side = edge & (np.abs(X) < 0.3 * A)
+    assert factor[side] == pytest.approx(1.0, abs=0.03)
+    dry = grid.y[:, None] > 2 * A + 0.2 * A
+    at135 = edge & dry & (np.abs(np.arctan2(Y, X) - 3 * np.pi / 4) < 0.05)
+    m = np.cos(np.pi / 4)
+    expected = np.cos(np.cbrt(ts**3 + m * (ta**3 - ts**3))) / np.cos(ts)
+    assert factor[at135] == pytest.approx(expected, rel=0.03)
+    assert expected < 0.85                    # a weaker suction than the static one
+    static = _Operators(ball_problem(cell=0.2 * A), grid)
+    assert np.all(static.pull_factor(flooded) == 1.0)
+
+
 def test_a_normal_length_in_metres_gives_every_grid_the_same_pull():
     """With the region smoothed over a fixed length for the meniscus's normal, the pull on
     the open cells round a tilted ellipse agrees between 0.2 a and 0.1 a cells (the coarse
@@ -240,6 +269,8 @@ def test_sub_cell_menisci_are_read_where_they_sit_in_their_open_cells():
     ("receding_meniscus", 3.0, "receding_meniscus = 3.0 is out of range: must be 'static', "
                                "'bretherton' or a factor in [0.5, 2]"),
     ("normal_length", 1e-9, "normal_length = 1e-09 is out of range: must be None or in"),
+    ("advancing_angle", 10.0, "advancing_angle = 10.0 is out of range: must be None or in "
+                              "[15, 90) deg"),
 ])
 def test_bad_parameters_are_refused_by_name_and_range(key, value, words):
     with pytest.raises(ValueError, match=words.replace("(", r"\(").replace(")", r"\)")
