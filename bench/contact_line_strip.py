@@ -22,6 +22,7 @@ gap's size away from the wall; the bench prints both, per in-plane cell size dx 
     python bench/contact_line_strip.py [--dx 0.2 0.1 0.05 0.025] [--levels fine]
         [--x-in 4] [--x-out 10] [--bridge 6.3] [--time 0.3] [--set KEY=VALUE ...]
         [--work DIR] [--reuse] [--save NAME.json]
+    python bench/contact_line_strip.py --plot FILE.png --plot-records RECORD.json ...
 """
 from __future__ import annotations
 
@@ -30,7 +31,6 @@ import itertools
 import json
 import shutil
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -43,7 +43,7 @@ sys.path.insert(0, str(ROOT))
 from foamlib import FoamFieldFile  # noqa: E402
 
 from bench.common import save, spec_option  # noqa: E402
-from bench.film_deposition import measure, strip_mesh, write_strip_case  # noqa: E402
+from bench.film_deposition import measure, run_or_reuse, strip_mesh  # noqa: E402
 from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
 from generator.gap_source import load_gap  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
@@ -103,6 +103,54 @@ def cox_voinov(theta_s_deg: float, ca: float, ratio: float) -> float:
     return float(np.degrees(np.cbrt(max(t3, 0.0))))
 
 
+def plot_records(paths: list[Path], out: Path) -> None:
+    """Left: each run's meniscus over time (a bridge dragged out ends where the line stops);
+    right: the apparent angle of the runs that settle, against dx, per set of wall cells."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = [r for path in paths for r in json.loads(Path(path).read_text())["rows"]]
+    walls = sorted({(r["level"], json.dumps(r["options"], sort_keys=True)) for r in rows})
+    fig, (ax_t, ax_a) = plt.subplots(1, 2, figsize=(12, 4.2))
+    for i, key in enumerate(walls):
+        color = plt.cm.tab10(i)
+        name = key[0] + "".join(f", {k.split('.')[-1]} {v}"
+                                for k, v in json.loads(key[1]).items())
+        mine = sorted((r for r in rows
+                       if (r["level"], json.dumps(r["options"], sort_keys=True)) == key),
+                      key=lambda r: -r["dx_over_a"])
+        for j, r in enumerate(mine):
+            w = r["writes"]
+            ax_t.plot([x["t_s"] for x in w], [x["x_rear_over_a"] for x in w], color=color,
+                      alpha=0.35 + 0.65 * (j + 1) / len(mine), lw=1.0,
+                      label=f"{name}, dx {r['dx_over_a']:g} a")
+        settled = [r for r in mine if np.isfinite(r["apparent_angle_deg"])
+                   and abs(r["meniscus_late_drift_over_a"]) < 0.05]
+        ax_a.plot([r["dx_over_a"] for r in settled], [r["apparent_angle_deg"] for r in settled],
+                  "o-", color=color, label=name)
+        dragged = [r for r in mine if r not in settled]
+        ax_a.plot([r["dx_over_a"] * (1 + 0.06 * i) for r in dragged],
+                  [90.0 - 2.5 * i] * len(dragged), "x", color=color, ms=8)
+    ax_t.set_xlabel("t (s)")
+    ax_t.set_ylabel("meniscus x / a")
+    ax_t.set_title("advancing meniscus on dry walls (strip, walls at -u)")
+    ax_t.legend(fontsize=6, ncol=2, loc="lower left")
+    ax_a.set_xscale("log")
+    ax_a.set_xticks([0.0125, 0.025, 0.05, 0.1, 0.2], ["0.0125", "0.025", "0.05", "0.1", "0.2"])
+    ax_a.minorticks_off()
+    ax_a.set_xlabel("in-plane cell dx / a")
+    ax_a.set_ylabel("apparent angle (deg)")
+    ax_a.set_ylim(0, 95)
+    ax_a.axhline(15.0, color="0.5", ls=":", lw=1)
+    ax_a.text(0.011, 17, "static angle", fontsize=7, color="0.4")
+    ax_a.set_title("settled runs; x at 90: dragged out or still moving")
+    ax_a.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out, dpi=130)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--dx", nargs="+", type=float, default=[0.2, 0.1, 0.05, 0.025],
@@ -121,7 +169,15 @@ def main(argv: list[str] | None = None) -> int:
                     help="measure a case already run to --time in --work instead of re-running")
     ap.add_argument("--save", help="record name under bench/results/ (written after each case)")
     ap.add_argument("--note", default="")
+    ap.add_argument("--plot", default="", help="a PNG of the runs in --plot-records")
+    ap.add_argument("--plot-records", nargs="+", default=[], metavar="RECORD.json")
+    ap.set_defaults(film=0.0)          # the strip's supply: none, the reservoir feeds it
     args = ap.parse_args(argv)
+    if args.plot:
+        if not args.plot_records:
+            ap.error("--plot needs --plot-records RECORD.json ...")
+        plot_records([Path(p) for p in args.plot_records], Path(args.plot))
+        return 0
     if not args.time > 0:
         ap.error(f"--time: {args.time} (valid range > 0)")
     if not 1.5 <= args.x_in < args.bridge < args.x_out:
@@ -138,20 +194,8 @@ def main(argv: list[str] | None = None) -> int:
         mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
         case = args.work / (f"{level}_dx{dx_a:g}_x{args.x_in:g}-{args.x_out:g}" + "".join(
             f"_{k.split('.')[-1]}{v}" for k, v in args.set))
-        record = case / "run.json"
-        if args.reuse and record.exists() and json.loads(record.read_text())["end_time_s"] == args.time:
-            run = json.loads(record.read_text())
-        else:
-            dt = write_strip_case(spec, case, mesh, args.bridge * a, 0.0, dx_a * a, args.time,
-                                  args.time / args.writes)
-            reverse_walls(spec, case)
-            t0 = time.perf_counter()
-            proc = runtime.run("interFoam", cwd=case, log_path=case / "log.interFoam",
-                               check=False)
-            run = {"max_delta_t_s": dt, "end_time_s": args.time,
-                   "status": "ok" if proc.returncode == 0 else "failed",
-                   "wall_s": time.perf_counter() - t0, "steps": proc.stdout.count("\nTime = ")}
-            record.write_text(json.dumps(run) + "\n")
+        run = run_or_reuse(runtime, spec, case, mesh, args.bridge * a, args, dx_a * a,
+                           adjust=reverse_walls)
         rows = measure(case, mesh, a, args.x_out * a)
         for r in rows:
             r["apparent_angle_deg"] = angle_at_meniscus(spec, table, r["x_rear_over_a"] * a)

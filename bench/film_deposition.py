@@ -29,6 +29,7 @@ import json
 import shutil
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
@@ -158,11 +159,12 @@ def measure(case: Path, mesh: PolyMesh, a: float, x_out: float) -> list[dict]:
     return rows
 
 
-def _run_or_reuse(runtime: FoamRuntime, spec: CaseSpec, case: Path, mesh: PolyMesh,
-                  x_bridge: float, args: argparse.Namespace, dx: float) -> dict:
-    """Write and run the strip case, or, with ``--reuse``, take the run already in ``case``
-    (its ``run.json``) when it ran the same time. Returns the run's step limit (s), status,
-    wall time (s) and steps."""
+def run_or_reuse(runtime: FoamRuntime, spec: CaseSpec, case: Path, mesh: PolyMesh,
+                 x_bridge: float, args: argparse.Namespace, dx: float,
+                 adjust: Callable[[CaseSpec, Path], None] | None = None) -> dict:
+    """Write the strip case (then ``adjust(spec, case)`` it, if given) and run it, or, with
+    ``--reuse``, take the run already in ``case`` (its ``run.json``) when it ran the same
+    time. Returns the run's step limit (s), status, wall time (s) and steps."""
     record = case / "run.json"
     if args.reuse and record.exists():
         run = json.loads(record.read_text())
@@ -170,6 +172,8 @@ def _run_or_reuse(runtime: FoamRuntime, spec: CaseSpec, case: Path, mesh: PolyMe
             return run
     dt = write_strip_case(spec, case, mesh, x_bridge, args.film, dx, args.time,
                           args.time / args.writes)
+    if adjust is not None:
+        adjust(spec, case)
     t0 = time.perf_counter()
     proc = runtime.run("interFoam", cwd=case, log_path=case / "log.interFoam", check=False)
     run = {"max_delta_t_s": dt, "end_time_s": args.time,
@@ -217,7 +221,7 @@ def main(argv: list[str] | None = None) -> int:
                  else f"_x{args.x_in:g}-{args.x_out:g}")
         case = args.work / (f"{level}_dx{dx_a:g}{strip}" + "".join(
             f"_{k.split('.')[-1]}{v}" for k, v in args.set))
-        run = _run_or_reuse(runtime, spec, case, mesh, x_ll, args, dx_a * a)
+        run = run_or_reuse(runtime, spec, case, mesh, x_ll, args, dx_a * a)
         rows = measure(case, mesh, a, args.x_out * a)
         late = [r for r in rows if r["t_s"] >= 0.6 * args.time]
         f = float(np.median([r["deposited_fraction"] for r in late])) if late else float("nan")
