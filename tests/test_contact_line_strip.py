@@ -1,0 +1,60 @@
+"""The contact-line strip (bench/contact_line_strip.py): its balance, the walls turned round,
+and a short real interFoam run of a bridge that dry walls advance into."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from foamlib import FoamFile
+
+from bench.contact_line_strip import (angle_at_meniscus, balance, meniscus_for_angle,
+                                      reverse_walls)
+from bench.film_deposition import columns, measure, strip_mesh, write_strip_case
+from generator.case_spec import make_case_spec
+from generator.gap_source import load_gap
+from runs.foam_runtime import FoamRuntime
+from tiny import SMALL
+
+
+@pytest.fixture(scope="module")
+def strip():
+    spec = make_case_spec(SMALL)
+    gap, _ = load_gap(spec.contact)
+    a = spec.a
+    return spec, gap, a, strip_mesh(spec, gap, 4 * a, 10 * a, 0.5 * a)
+
+
+def test_the_meniscus_position_and_its_apparent_angle_invert_each_other(strip):
+    spec, gap, a, _ = strip
+    table = balance(spec, gap, 4 * a, 10 * a)
+    x = [meniscus_for_angle(spec, table, t) for t in (15.0, 30.0, 47.0, 70.0)]
+    assert all(4 * a < xi < 10 * a for xi in x)
+    assert x == sorted(x, reverse=True)         # less suction: nearer the reservoir
+    for theta, xi in zip((15.0, 30.0, 47.0, 70.0), x):
+        assert angle_at_meniscus(spec, table, xi) == pytest.approx(theta, abs=0.5)
+    # at the reservoir no drag has built up: no angle below a right one balances there
+    assert np.isnan(angle_at_meniscus(spec, table, 4 * a))
+
+
+def test_dry_walls_run_into_a_bridge_fed_by_the_reservoir(strip, tmp_path):
+    spec, gap, a, mesh = strip
+    case = tmp_path / "strip"
+    write_strip_case(spec, case, mesh, x_bridge=7 * a, film=0.0, dx=0.5 * a, end_time=0.02,
+                     write_interval=0.01)
+    reverse_walls(spec, case)
+    u = FoamFile(case / "0" / "U")["boundaryField"]
+    assert u["disc"]["value"][0] == pytest.approx(-spec.wall_speed)
+    assert u["ball"]["omega"] == pytest.approx(spec.wall_speed / spec.contact.radius)
+    assert u["supply"]["type"] == "pressureInletOutletVelocity"
+    assert FoamFile(case / "0" / "alpha.oil")["boundaryField"]["supply"]["inletValue"] == 1.0
+    FoamRuntime.from_environment().run("interFoam", cwd=case, log_path=case / "log.interFoam")
+    rows = measure(case, mesh, a, 10 * a)
+    assert [r["t_s"] for r in rows] == pytest.approx([0.01, 0.02])
+    # the walls drag the oil towards the reservoir: on cells this coarse the meniscus holds
+    # no suction that could stop it (docs/cases.md, "The region's sides are moving contact
+    # lines"), and the reservoir keeps the bridge's narrow end full
+    assert rows[-1]["x_rear_over_a"] < rows[0]["x_rear_over_a"] < 7.0
+    alpha = np.asarray(FoamFile(case / "0.02" / "alpha.oil")["internalField"], float)
+    _, h, oil = columns(mesh, alpha)
+    assert oil[0] == pytest.approx(h[0], rel=0.02)
+    assert oil[-1] < 0.05 * h[-1]               # the walls come in dry
