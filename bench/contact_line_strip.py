@@ -31,6 +31,7 @@ import itertools
 import json
 import shutil
 import sys
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -45,13 +46,18 @@ from foamlib import FoamFieldFile  # noqa: E402
 from bench.common import save, spec_option  # noqa: E402
 from bench.film_deposition import measure, run_or_reuse, strip_mesh  # noqa: E402
 from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
+from generator.case_writer import oil_fraction  # noqa: E402
 from generator.gap_source import load_gap  # noqa: E402
+from generator.mesh import PolyMesh  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
 
 
-def reverse_walls(spec: CaseSpec, case: Path) -> None:
+def reverse_walls(spec: CaseSpec, case: Path, mesh: PolyMesh | None = None,
+                  precursor: float = 0.0) -> None:
     """Turn the film strip written by ``write_strip_case`` into the advancing one: both walls
-    at -u, and the supply patch an oil reservoir at ambient pressure (oil in, anything out)."""
+    at -u, and the supply patch an oil reservoir at ambient pressure (oil in, anything out).
+    With a ``precursor`` [m] (and the strip's ``mesh``) the walls come in wetted by a layer
+    that thick each, instead of dry."""
     u = spec.wall_speed
     with FoamFieldFile(case / "0.orig" / "U") as f:
         f.boundary_field["disc"]["value"] = np.array([-u, 0.0, 0.0])
@@ -62,16 +68,27 @@ def reverse_walls(spec: CaseSpec, case: Path) -> None:
         f.boundary_field["supply"] = {"type": "totalPressure", "p0": 0.0, "value": 0.0}
     with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
         f.boundary_field["supply"] = {"type": "inletOutlet", "inletValue": 1.0, "value": 1.0}
+        if precursor > 0:
+            z = mesh.points[mesh.faces[mesh.patch_slice("outlet")], 2]
+            layers = spec.supply.model_copy(update={"mode": "layers", "disc_layer": precursor,
+                                                    "ball_layer": precursor})
+            frac = oil_fraction(spec.model_copy(update={"supply": layers}), z.min(1), z.max(1),
+                                z.max(), 1.0)
+            f.boundary_field["outlet"] = {"type": "inletOutlet", "inletValue": frac,
+                                          "value": frac}
     shutil.rmtree(case / "0")
     shutil.copytree(case / "0.orig", case / "0")
 
 
-def balance(spec: CaseSpec, gap, x_in: float, x_out: float):
+def balance(spec: CaseSpec, gap, x_in: float, x_out: float, precursor: float = 0.0):
     """The bridge's balance on y = 0: x (m), gap h (m), its slope, and the pressure the walls'
-    drag takes off from the reservoir to each x (Pa, positive), int 12 eta u / h^2 dx."""
+    drag takes off from the reservoir to each x (Pa, positive), int 12 eta u / h^2 dx; with
+    a precursor layer [m] on each wall, whose oil the bridge passes on to the reservoir,
+    int 12 eta u (h - 2 precursor) / h^3 dx."""
     x = np.linspace(x_in, x_out, 4001)
     h = gap(x, np.zeros_like(x))
-    drop = cumulative_trapezoid(12.0 * spec.oil_viscosity * spec.speed / h**2, x, initial=0.0)
+    drop = cumulative_trapezoid(12.0 * spec.oil_viscosity * spec.speed * (h - 2 * precursor)
+                                / h**3, x, initial=0.0)
     return x, h, np.gradient(h, x), drop
 
 
@@ -160,6 +177,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--x-in", type=float, default=4.0, help="oil reservoir at x = X a")
     ap.add_argument("--x-out", type=float, default=10.0, help="dry walls enter at x = X a")
     ap.add_argument("--bridge", type=float, default=6.3, help="oil at t = 0 up to x = X a")
+    ap.add_argument("--precursor", type=float, default=0.0,
+                    help="a layer on each wall coming in [m]: wetted walls instead of dry")
     ap.add_argument("--time", type=float, default=0.3, help="simulated time [s]")
     ap.add_argument("--writes", type=int, default=30, help="writes over the run")
     ap.add_argument("--set", action="append", default=[], type=spec_option,
@@ -190,12 +209,13 @@ def main(argv: list[str] | None = None) -> int:
         gap, _ = load_gap(spec.contact)
         a = spec.a
         ca = spec.oil_viscosity * spec.speed / spec.physics.surface_tension
-        table = balance(spec, gap, args.x_in * a, args.x_out * a)
+        table = balance(spec, gap, args.x_in * a, args.x_out * a, args.precursor)
         mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
         case = args.work / (f"{level}_dx{dx_a:g}_x{args.x_in:g}-{args.x_out:g}" + "".join(
-            f"_{k.split('.')[-1]}{v}" for k, v in args.set))
+            f"_{k.split('.')[-1]}{v}" for k, v in args.set)
+            + (f"_pre{args.precursor:g}" if args.precursor else ""))
         run = run_or_reuse(runtime, spec, case, mesh, args.bridge * a, args, dx_a * a,
-                           adjust=reverse_walls)
+                           adjust=partial(reverse_walls, mesh=mesh, precursor=args.precursor))
         rows = measure(case, mesh, a, args.x_out * a)
         for r in rows:
             r["apparent_angle_deg"] = angle_at_meniscus(spec, table, r["x_rear_over_a"] * a)
@@ -210,7 +230,7 @@ def main(argv: list[str] | None = None) -> int:
                   "gap_at_meniscus_m": h_m, "apparent_angle_deg": theta_app,
                   "meniscus_static_angle_over_a":
                       meniscus_for_angle(spec, table, spec.physics.contact_angle) / a,
-                  "options": dict(args.set), "writes": rows}
+                  "precursor_m": args.precursor, "options": dict(args.set), "writes": rows}
         results.append(result)
         print(f"{level:>7} dx {dx_a:6.4g} a ({dx_a * a * 1e6:5.1f} um) {mesh.n_cells:6d} cells "
               f"{result['steps']:6d} steps {result['wall_s']:6.0f} s {result['status']}: "
