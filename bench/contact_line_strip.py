@@ -120,6 +120,11 @@ def cox_voinov(theta_s_deg: float, ca: float, ratio: float) -> float:
     return float(np.degrees(np.cbrt(max(t3, 0.0))))
 
 
+#: the plot's names for spec options
+SHORT = {"n_layers": "layers", "wall_grading": "grading", "interface_schemes": "schemes",
+         "alpha_subcycles": "sub-cycles", "capillary_safety": "safety"}
+
+
 def plot_records(paths: list[Path], out: Path) -> None:
     """Left: each run's meniscus over time (a bridge dragged out ends where the line stops);
     right: the apparent angle of the runs that settle, against dx, per set of wall cells."""
@@ -130,10 +135,10 @@ def plot_records(paths: list[Path], out: Path) -> None:
 
     rows = [r for path in paths for r in json.loads(Path(path).read_text())["rows"]]
     walls = sorted({(r["level"], json.dumps(r["options"], sort_keys=True)) for r in rows})
-    fig, (ax_t, ax_a) = plt.subplots(1, 2, figsize=(12, 4.2))
+    fig, (ax_t, ax_a) = plt.subplots(1, 2, figsize=(12, 5.6))
     for i, key in enumerate(walls):
         color = plt.cm.tab10(i)
-        name = key[0] + "".join(f", {k.split('.')[-1]} {v}"
+        name = key[0] + "".join(f", {SHORT.get(k.split('.')[-1], k.split('.')[-1])} {v}"
                                 for k, v in json.loads(key[1]).items())
         mine = sorted((r for r in rows
                        if (r["level"], json.dumps(r["options"], sort_keys=True)) == key),
@@ -153,7 +158,7 @@ def plot_records(paths: list[Path], out: Path) -> None:
     ax_t.set_xlabel("t (s)")
     ax_t.set_ylabel("meniscus x / a")
     ax_t.set_title("advancing meniscus on dry walls (strip, walls at -u)")
-    ax_t.legend(fontsize=6, ncol=2, loc="lower left")
+    ax_t.legend(fontsize=6, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.14))
     ax_a.set_xscale("log")
     ax_a.set_xticks([0.0125, 0.025, 0.05, 0.1, 0.2], ["0.0125", "0.025", "0.05", "0.1", "0.2"])
     ax_a.minorticks_off()
@@ -163,7 +168,7 @@ def plot_records(paths: list[Path], out: Path) -> None:
     ax_a.axhline(15.0, color="0.5", ls=":", lw=1)
     ax_a.text(0.011, 17, "static angle", fontsize=7, color="0.4")
     ax_a.set_title("settled runs; x at 90: dragged out or still moving")
-    ax_a.legend(fontsize=7)
+    ax_a.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14))
     fig.tight_layout()
     fig.savefig(out, dpi=130)
 
