@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 from foamlib import FoamFieldFile
+from scipy.spatial import cKDTree
 
 from generator.case_writer import AIR_GAS_CONSTANT, META, CaseGeometry
 
@@ -33,6 +34,9 @@ class Structure:
     base_x: np.ndarray
     base_y: np.ndarray
     patches: dict[str, tuple[int, int]]  # name -> (start among boundary faces, size)
+    #: per base cell: the height of its cell on the disc [m] and its in-plane area [m2]
+    wall_cell: np.ndarray | None = None
+    footprint: np.ndarray | None = None
 
     @classmethod
     def load(cls, case: str | os.PathLike) -> "Structure":
@@ -45,7 +49,13 @@ class Structure:
         by = np.bincount(base, centres[:, 1], minlength=n_base) / count
         patches = {str(n): (int(s), int(z)) for n, s, z in
                    zip(d["patch_names"], d["patch_starts"], d["patch_sizes"])}
-        return cls(d["cell_volumes"], base, d["layer"], bx, by, patches)
+        # the cell on the flat disc (z = 0) spans twice its centre's height
+        on_disc = d["layer"] == 0
+        wall = np.zeros(n_base)
+        wall[base[on_disc]] = 2.0 * centres[on_disc, 2]
+        area = np.zeros(n_base)
+        area[base[on_disc]] = d["cell_volumes"][on_disc] / wall[base[on_disc]]
+        return cls(d["cell_volumes"], base, d["layer"], bx, by, patches, wall, area)
 
     def gap_mean(self, field: np.ndarray) -> np.ndarray:
         """Per base cell, the volume-weighted mean of a cell field over the column across the
@@ -231,6 +241,25 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     return Sample(time=float(folder.name), oil_volume=volume, oil_in=q_in, oil_out=q_out,
                   pattern=pattern, oil_flux_exact=exact, oil_out_by_boundary=out_by_boundary,
                   **gas)
+
+
+def advancing_front_cells(folder: Path, structure: Structure, geom: CaseGeometry,
+                          track_half_width: float) -> np.ndarray:
+    """Along the flooded region's edge where dry walls run into it, off the track
+    (:func:`metrics.advancing_front` of the mid-gap oil at ``folder``): the in-plane size of
+    the column there (the square root of its area) over its wall cell's height. A contact line
+    advancing onto dry walls holds a capillary suction only where that is within some 15
+    (``bench/contact_line_strip.py``). Empty without such an edge."""
+    alpha, _ = _read_alpha(_complete(folder / "alpha.oil"), structure)
+    mid = structure.mid_gap(alpha, geom.n_layers)
+    r = metrics.raster(structure.base_x, structure.base_y, mid, pattern_geometry(geom))
+    points = metrics.advancing_front(r, track_half_width)
+    if not len(points):
+        return np.empty(0)
+    y = np.abs(points[:, 1]) if geom.symmetric else points[:, 1]
+    _, i = cKDTree(np.stack([structure.base_x, structure.base_y], 1)).query(
+        np.stack([points[:, 0], y], 1))
+    return np.sqrt(structure.footprint[i]) / structure.wall_cell[i]
 
 
 def off_outlet_share(out_by_boundary: dict[str, float]) -> float | None:

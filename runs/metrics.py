@@ -425,6 +425,26 @@ def _bubble(r: Raster, outer: np.ndarray, threshold: float) -> dict[str, Any]:
 # public API
 
 
+def advancing_front(r: Raster, track_half_width: float, threshold: float = 0.5) -> np.ndarray:
+    """Points (x, y) [m], shape (n, 2), of the flooded region's edge that the walls, rolling
+    along +x, run into from dry ground: flooded pixels whose upstream neighbour is neither
+    flooded nor island, off the supply track (|y| > ``track_half_width`` [m]). There the oil
+    meets the walls in contact lines advancing onto dry walls (docs/cases.md, "The region's
+    sides are moving contact lines"). Empty without a flooded region."""
+    if not isinstance(r, Raster):
+        raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
+    if not (math.isfinite(track_half_width) and track_half_width >= 0):
+        raise ValueError(f"track_half_width: must be a finite length >= 0 m, got "
+                         f"{track_half_width!r}")
+    flooded = _flooded(r.oil(_check_threshold(threshold)), _rim_mask(r.island))
+    behind = np.zeros_like(flooded)                # the pixel upstream is flooded or island
+    behind[:, 1:] = flooded[:, :-1] | r.island[:, :-1]
+    behind[:, 0] = True                            # the domain's upstream edge: not known
+    xx, yy = np.meshgrid(r.x, r.y)
+    front = flooded & ~behind & (np.abs(yy) > track_half_width)
+    return np.stack([xx[front], yy[front]], axis=1)
+
+
 def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any]:
     """Flow-pattern metrics of a :class:`Raster`; see :func:`flow_pattern`."""
     threshold = _check_threshold(threshold)

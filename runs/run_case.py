@@ -63,6 +63,11 @@ CLEARANCE_WARNING = 1.0
 #: against a run at 0.1 a, 11-16 % against one at 0.05 a on the rear arc; docs/cases.md, "One
 #: step finer at the rear meniscus")
 REAR_CELL_WARNING = 0.15
+#: The in-plane cells over the wall cell's height along the flooded region's front off the
+#: track, where dry walls run into it, above which a run warns: in the contact-line strip the
+#: meniscus holds no capillary suction beyond some 15 (docs/cases.md, "The region's sides are
+#: moving contact lines").
+FRONT_CELL_WARNING = 15.0
 
 
 class CaseBusy(RuntimeError):
@@ -503,6 +508,36 @@ def rear_cell_warnings(rear_cell: float | None) -> list[str]:
             f"the rear meniscus\""]
 
 
+def front_contact_line_cells(spec: CaseSpec, geom: CaseGeometry, case: Path,
+                             pattern: dict | None) -> float | None:
+    """The median, along the closed flooded region's edge where dry walls run into it off
+    the track, of the in-plane cell size over the wall cell's height
+    (:func:`case_fields.advancing_front_cells`, at the last write). None for an open wake, no
+    region or no such edge."""
+    folders = case_fields.time_folders(case)
+    if (pattern or {}).get("state") != "I" or not folders:
+        return None
+    try:
+        ratios = case_fields.advancing_front_cells(
+            folders[-1][1], case_fields.Structure.load(case), geom,
+            spec.supply.track_half_width)
+    except (OSError, ValueError, KeyError):     # a last write cut short: no figure
+        return None
+    return float(np.median(ratios)) if len(ratios) else None
+
+
+def front_cell_warnings(front_cells: float | None) -> list[str]:
+    """A warning when the region's front off the track, where dry walls run into it, sits in
+    cells wider than :data:`FRONT_CELL_WARNING` wall cells."""
+    if front_cells is None or front_cells <= FRONT_CELL_WARNING:
+        return []
+    return [f"the flooded region's front off the track, where dry walls run into it, sits in "
+            f"in-plane cells {front_cells:.0f} times its wall cells (above "
+            f"{FRONT_CELL_WARNING:g}): there interFoam gives the advancing contact line no "
+            f"capillary suction, and the flooded width is not converged; docs/cases.md, \"The "
+            f"region's sides are moving contact lines\""]
+
+
 def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, tail, wall, case) -> dict:
     last = history[-1] if history else None
     pattern = dict(last.pattern) if last else {}
@@ -511,6 +546,8 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
     # boundary by design and lays no films: these warnings are for a region surrounded by air
     surrounded = geom.open_inflow_oil == 0.0
     rear_cell = rear_meniscus_cell(spec, pattern) if surrounded else None
+    front_cells = (front_contact_line_cells(spec, geom, case, pattern)
+                   if surrounded and not failed else None)
     out = {
         "status": "failed" if failed else ("interrupted" if reason == "interrupted" else "finished"),
         "end_reason": reason,
@@ -541,7 +578,9 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
         "mesh_gap_mismatch": geom.gap_mismatch,
         "ball_wall_steps": geom.ball_wall_steps,
         "rear_meniscus_cell_over_a": rear_cell,
-        "warnings": "; ".join(mesh_warnings(geom) + rear_cell_warnings(rear_cell) + (
+        "front_contact_line_cells_over_wall_cell": front_cells,
+        "warnings": "; ".join(mesh_warnings(geom) + rear_cell_warnings(rear_cell)
+                              + front_cell_warnings(front_cells) + (
             boundary_warnings(off_outlet, pattern) if surrounded else [])),
     }
     if failed:

@@ -25,7 +25,8 @@ from runs import case_fields
 from runs.cli import parse_value
 from runs.foam_runtime import FoamRuntime
 from runs.report.case_data import read_history
-from runs.run_case import OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, rear_cell_warnings, run_case
+from runs.run_case import (FRONT_CELL_WARNING, OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT,
+                           front_cell_warnings, rear_cell_warnings, run_case)
 from tiny import SMALL
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -638,9 +639,14 @@ def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path)
     with FoamFile(tmp_path / "thin" / "system" / "controlDict") as f:
         f["endTime"] = 1e-4
     m = run_case(tmp_path / "thin", wall_limit=120)
-    # after the mesh's warning, the coarse rear cells' of the same run
+    # after the mesh's warning, the coarse rear cells' of the same run, and its front's off
+    # the track, where dry walls run into the puddle: the small case's cells there are tens
+    # of its wall cells wide, past the contact-line strip's 15
     assert m["status"] == "finished" and m["warnings"] == "; ".join(
-        warnings + rear_cell_warnings(m["rear_meniscus_cell_over_a"])), m
+        warnings + rear_cell_warnings(m["rear_meniscus_cell_over_a"])
+        + front_cell_warnings(m["front_contact_line_cells_over_wall_cell"])), m
+    assert m["front_contact_line_cells_over_wall_cell"] > FRONT_CELL_WARNING
+    assert "dry walls run into it" in m["warnings"]
 
 
 def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
@@ -839,6 +845,8 @@ def test_single_phase_case_stays_oil(tmp_path):
     assert "boundary" not in m["warnings"], m["warnings"]
     # and lays no films at a rear meniscus
     assert m["rear_meniscus_cell_over_a"] is None and "rear meniscus" not in m["warnings"]
+    # nor meets dry walls with a contact line
+    assert m["front_contact_line_cells_over_wall_cell"] is None
 
 
 def test_meniscus_pressure_reads_a_known_jump_off_written_fields(small_case, tmp_path):

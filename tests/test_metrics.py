@@ -320,3 +320,23 @@ def test_bubble_metrics_on_known_shapes(field, length, width, enclosed):
     assert p["bubble_enclosed"] is enclosed
     if width is not None:
         assert p["bubble_width_over_a"] == pytest.approx(width, abs=TOL)
+
+
+def test_the_advancing_front_is_the_upstream_edge_off_the_track():
+    """On a round region of 4 a, with a track of 2 a: the edge the walls (rolling along +x) run
+    into from dry ground is the upstream half of the circle with |y| > 2 a; none of it
+    downstream, on the track or inside; a track wider than the region leaves none."""
+    from runs.metrics import advancing_front
+
+    x, y = centres()
+    r = raster(x, y, alpha_of(ring(x, y)), GEOM)
+    pts = advancing_front(r, 2 * A)
+    assert len(pts) > 20
+    radius = np.hypot(pts[:, 0], pts[:, 1])
+    assert np.all(np.abs(radius - 4 * A) < 0.15 * A)        # on the meniscus
+    assert np.all(pts[:, 0] < 0.3 * A)                      # where the walls come in
+    assert np.all(np.abs(pts[:, 1]) > 2 * A)                # off the track
+    assert (pts[:, 1] > 0).any() and (pts[:, 1] < 0).any()  # both halves of the picture
+    assert len(advancing_front(r, 5 * A)) == 0
+    with pytest.raises(ValueError, match="track_half_width"):
+        advancing_front(r, -1.0)

@@ -32,6 +32,8 @@ METRICS: dict[str, Unit] = {
                                  "a", 1.0),
     "flooded_nearest_boundary": ("Open boundary nearest the flooded region", "", None),
     "rear_meniscus_cell_over_a": ("In-plane cell size at the rear meniscus (y = 0)", "a", 1.0),
+    "front_contact_line_cells_over_wall_cell": (
+        "In-plane cells over wall cells where dry walls run into the region", "", 1.0),
     "wake_gas_length_over_a": ("Gas behind the contact on y = 0, from x = a", "a", 1.0),
     "wake_open": ("Wake open (outer air reaches the contact exit)", "", None),
     "inlet_starved": ("Inlet starved (outer air reaches the contact inlet)", "", None),
