@@ -27,7 +27,6 @@ gap's size away from the wall; the bench prints both, per in-plane cell size dx 
 from __future__ import annotations
 
 import argparse
-import itertools
 import json
 import shutil
 import sys
@@ -43,11 +42,10 @@ sys.path.insert(0, str(ROOT))
 
 from foamlib import FoamFieldFile  # noqa: E402
 
-from bench.common import save, spec_option  # noqa: E402
-from bench.film_deposition import measure, run_or_reuse, strip_mesh  # noqa: E402
-from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
+from bench.film_deposition import (add_strip_options, measure, run_or_reuse,  # noqa: E402
+                                    save_rows, strip_mesh, sweep)
+from generator.case_spec import CaseSpec  # noqa: E402
 from generator.case_writer import oil_fraction  # noqa: E402
-from generator.gap_source import load_gap  # noqa: E402
 from generator.mesh import PolyMesh  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
 
@@ -175,24 +173,13 @@ def plot_records(paths: list[Path], out: Path) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--dx", nargs="+", type=float, default=[0.2, 0.1, 0.05, 0.025],
-                    help="in-plane cell sizes [a]")
-    ap.add_argument("--levels", nargs="+", default=["fine"],
-                    help="levels whose wall layers and capillary safety are used")
+    add_strip_options(ap, [0.2, 0.1, 0.05, 0.025], "fine", 0.3, 30,
+                      ROOT / "runs" / "bench" / "contact_line")
     ap.add_argument("--x-in", type=float, default=4.0, help="oil reservoir at x = X a")
     ap.add_argument("--x-out", type=float, default=10.0, help="dry walls enter at x = X a")
     ap.add_argument("--bridge", type=float, default=6.3, help="oil at t = 0 up to x = X a")
     ap.add_argument("--precursor", type=float, default=0.0,
                     help="a layer on each wall coming in [m]: wetted walls instead of dry")
-    ap.add_argument("--time", type=float, default=0.3, help="simulated time [s]")
-    ap.add_argument("--writes", type=int, default=30, help="writes over the run")
-    ap.add_argument("--set", action="append", default=[], type=spec_option,
-                    metavar="KEY=VALUE", help="any other spec option (e.g. mesh.n_layers=20)")
-    ap.add_argument("--work", type=Path, default=ROOT / "runs" / "bench" / "contact_line")
-    ap.add_argument("--reuse", action="store_true",
-                    help="measure a case already run to --time in --work instead of re-running")
-    ap.add_argument("--save", help="record name under bench/results/ (written after each case)")
-    ap.add_argument("--note", default="")
     ap.add_argument("--plot", default="", help="a PNG of the runs in --plot-records")
     ap.add_argument("--plot-records", nargs="+", default=[], metavar="RECORD.json")
     ap.set_defaults(film=0.0)          # the strip's supply: none, the reservoir feeds it
@@ -209,10 +196,7 @@ def main(argv: list[str] | None = None) -> int:
                  "1.5 <= x_in < bridge < x_out (a)")
     runtime = FoamRuntime.from_environment()
     results = []
-    for level, dx_a in itertools.product(args.levels, args.dx):
-        spec = make_case_spec({"mesh": {"resolution": level}}, **dict(args.set))
-        gap, _ = load_gap(spec.contact)
-        a = spec.a
+    for level, dx_a, spec, gap, a in sweep(args):
         ca = spec.oil_viscosity * spec.speed / spec.physics.surface_tension
         table = balance(spec, gap, args.x_in * a, args.x_out * a, args.precursor)
         mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
@@ -245,10 +229,7 @@ def main(argv: list[str] | None = None) -> int:
               f" Cox-Voinov at L/lambda = h/dx: "
               f"{cox_voinov(spec.physics.contact_angle, ca, h_m / (dx_a * a)):5.1f} deg)",
               flush=True)
-        if args.save:   # after every case: an interrupted sweep keeps what it measured
-            save(args.save, {"note": args.note,
-                             "args": {k: str(v) for k, v in vars(args).items()},
-                             "rows": results})
+        save_rows(args, results)   # after every case: an interrupted sweep keeps them
     return 0
 
 

@@ -29,7 +29,7 @@ import json
 import shutil
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import replace
 from pathlib import Path
 
@@ -183,25 +183,49 @@ def run_or_reuse(runtime: FoamRuntime, spec: CaseSpec, case: Path, mesh: PolyMes
     return run
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--dx", nargs="+", type=float, default=[0.8, 0.4, 0.2, 0.1, 0.05],
-                    help="in-plane cell sizes [a]")
-    ap.add_argument("--levels", nargs="+", default=["coarse"],
+def sweep(args: argparse.Namespace) -> Iterator[tuple[str, float, CaseSpec, Callable, float]]:
+    """Each (level, dx in a) of --levels x --dx, with its spec (the level and --set), its gap
+    h(x, y) and a [m]."""
+    for level, dx_a in itertools.product(args.levels, args.dx):
+        spec = make_case_spec({"mesh": {"resolution": level}}, **dict(args.set))
+        gap, _ = load_gap(spec.contact)
+        yield level, dx_a, spec, gap, spec.a
+
+
+def save_rows(args: argparse.Namespace, rows: list[dict]) -> None:
+    """With --save, write the record of a strip sweep so far (its note, options and rows)."""
+    if args.save:
+        save(args.save, {"note": args.note, "args": {k: str(v) for k, v in vars(args).items()},
+                         "rows": rows})
+
+
+def add_strip_options(ap: argparse.ArgumentParser, dx: list[float], level: str,
+                      time_s: float, writes: int, work: Path) -> None:
+    """The options the strip benches share, with their defaults: the cells (--dx, a) and
+    levels, the run's length and writes, spec edits, where the cases go, --reuse and the
+    record (--save, --note)."""
+    ap.add_argument("--dx", nargs="+", type=float, default=dx, help="in-plane cell sizes [a]")
+    ap.add_argument("--levels", nargs="+", default=[level],
                     help="levels whose wall layers and capillary safety are used")
-    ap.add_argument("--film", type=float, default=FILM,
-                    help="oil carried in, as a film thickness at the rolling speed [m]")
-    ap.add_argument("--x-in", type=float, default=X_IN, help="supply at x = X a")
-    ap.add_argument("--x-out", type=float, default=X_OUT, help="outlet at x = X a")
-    ap.add_argument("--time", type=float, default=1.0, help="simulated time [s]")
-    ap.add_argument("--writes", type=int, default=50, help="writes over the run")
+    ap.add_argument("--time", type=float, default=time_s, help="simulated time [s]")
+    ap.add_argument("--writes", type=int, default=writes, help="writes over the run")
     ap.add_argument("--set", action="append", default=[], type=spec_option,
                     metavar="KEY=VALUE", help="any other spec option (e.g. mesh.n_layers=20)")
-    ap.add_argument("--work", type=Path, default=ROOT / "runs" / "bench" / "film_deposition")
+    ap.add_argument("--work", type=Path, default=work)
     ap.add_argument("--reuse", action="store_true",
                     help="measure a case already run to --time in --work instead of re-running")
     ap.add_argument("--save", help="record name under bench/results/ (written after each case)")
     ap.add_argument("--note", default="")
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_strip_options(ap, [0.8, 0.4, 0.2, 0.1, 0.05], "coarse", 1.0, 50,
+                      ROOT / "runs" / "bench" / "film_deposition")
+    ap.add_argument("--film", type=float, default=FILM,
+                    help="oil carried in, as a film thickness at the rolling speed [m]")
+    ap.add_argument("--x-in", type=float, default=X_IN, help="supply at x = X a")
+    ap.add_argument("--x-out", type=float, default=X_OUT, help="outlet at x = X a")
     args = ap.parse_args(argv)
     for name, value in (("--film", args.film), ("--time", args.time)):
         if not value > 0:
@@ -210,10 +234,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--x-in {args.x_in}, --x-out {args.x_out}: need 1.5 <= x_in < x_out (a)")
     runtime = FoamRuntime.from_environment()
     results = []
-    for level, dx_a in itertools.product(args.levels, args.dx):
-        spec = make_case_spec({"mesh": {"resolution": level}}, **dict(args.set))
-        gap, _ = load_gap(spec.contact)
-        a = spec.a
+    for level, dx_a, spec, gap, a in sweep(args):
         ll = landau_levich(spec.oil_viscosity, spec.speed, spec.physics.surface_tension)
         x_ll = x_at_gap(gap, args.film / ll, args.x_in * a, args.x_out * a)
         mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
@@ -241,10 +262,7 @@ def main(argv: list[str] | None = None) -> int:
               f"{f * 100:5.2f} % of the gap (LL {ll * 100:4.2f} %, x{f / ll:5.2f}); rear "
               f"{result['x_rear_last_over_a'] or float('nan'):6.2f} a at the end, balance "
               f"{result['x_rear_balance_over_a']:6.2f} a (LL {x_ll / a:5.2f} a)", flush=True)
-        if args.save:   # after every case: an interrupted sweep keeps what it measured
-            save(args.save, {"note": args.note,
-                             "args": {k: str(v) for k, v in vars(args).items()},
-                             "rows": results})
+        save_rows(args, results)   # after every case: an interrupted sweep keeps them
     return 0
 
 
