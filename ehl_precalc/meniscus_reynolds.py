@@ -116,9 +116,10 @@ class ThinFilmProblem:
             meet it square on; None: the static angle. Cox-Voinov's theta^3 - theta_s^3 grows
             with the capillary number of the contact line's speed, so at an angle theta^3
             takes the share n of the step from theta_s^3 (n: the x part of the meniscus's
-            inward normal, from the region smoothed over ``normal_length``). A strip of
-            interFoam with dry walls advancing at the nominal Ca = 0.0058 converges in its
-            cells to 46-48 deg (``bench/contact_line_strip.py``).
+            inward normal, from the region smoothed over ``normal_length``). In a strip of
+            interFoam with dry walls advancing at the nominal Ca = 0.0058 the meniscus
+            settles at 44-51 deg on in-plane cells within some 15 wall cells, and holds no
+            suction at all on coarser ones (``bench/contact_line_strip.py``).
         meniscus_position: where a meniscus sits in the open cell beside a flooded one:
             "sub-cell", as far into it as the cell's bulk oil fills it (its oil beyond the
             layers or films the walls carry, over the rest of its gap), so that the

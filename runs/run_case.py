@@ -410,7 +410,8 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample,
     if reason is None:
         reason = "end_time" if rc == 0 else "diverged"
     failed = reason == "diverged" or (rc != 0 and reason not in ("interrupted",) and rc != -9)
-    metrics = _final_metrics(spec, geom, v0, history, reason, failed, rc, tail, wall, case)
+    metrics = _final_metrics(spec, geom, structure, v0, history, reason, failed, rc, tail, wall,
+                             case)
     metrics["steady_test"] = steady_kind
     atomic_write_json(case / "metrics.json", metrics)
     return metrics
@@ -508,7 +509,8 @@ def rear_cell_warnings(rear_cell: float | None) -> list[str]:
             f"the rear meniscus\""]
 
 
-def front_contact_line_cells(spec: CaseSpec, geom: CaseGeometry, case: Path,
+def front_contact_line_cells(spec: CaseSpec, geom: CaseGeometry,
+                             structure: case_fields.Structure, case: Path,
                              pattern: dict | None) -> float | None:
     """The median, along the closed flooded region's edge where dry walls run into it off
     the track, of the in-plane cell size over the wall cell's height
@@ -518,9 +520,8 @@ def front_contact_line_cells(spec: CaseSpec, geom: CaseGeometry, case: Path,
     if (pattern or {}).get("state") != "I" or not folders:
         return None
     try:
-        ratios = case_fields.advancing_front_cells(
-            folders[-1][1], case_fields.Structure.load(case), geom,
-            spec.supply.track_half_width)
+        ratios = case_fields.advancing_front_cells(folders[-1][1], structure, geom,
+                                                   spec.supply.track_half_width)
     except (OSError, ValueError, KeyError):     # a last write cut short: no figure
         return None
     return float(np.median(ratios)) if len(ratios) else None
@@ -538,7 +539,8 @@ def front_cell_warnings(front_cells: float | None) -> list[str]:
             f"region's sides are moving contact lines\""]
 
 
-def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, tail, wall, case) -> dict:
+def _final_metrics(spec, geom: CaseGeometry, structure, v0, history, reason, failed, rc, tail, wall,
+                   case) -> dict:
     last = history[-1] if history else None
     pattern = dict(last.pattern) if last else {}
     off_outlet = case_fields.off_outlet_share(last.oil_out_by_boundary) if last else None
@@ -546,7 +548,7 @@ def _final_metrics(spec, geom: CaseGeometry, v0, history, reason, failed, rc, ta
     # boundary by design and lays no films: these warnings are for a region surrounded by air
     surrounded = geom.open_inflow_oil == 0.0
     rear_cell = rear_meniscus_cell(spec, pattern) if surrounded else None
-    front_cells = (front_contact_line_cells(spec, geom, case, pattern)
+    front_cells = (front_contact_line_cells(spec, geom, structure, case, pattern)
                    if surrounded and not failed else None)
     out = {
         "status": "failed" if failed else ("interrupted" if reason == "interrupted" else "finished"),
