@@ -399,10 +399,8 @@ class _Operators:
         self.g_side = 0.0 * grid.h_side if prob.closed_side else 2.0 * k * grid.h_side**3
         self.g_out = 2.0 * self.gx[:, -1] if self.gx.shape[1] else np.zeros(0)
         self.cx_out = np.nan_to_num(u * grid.h[:, -1] * d)
-        cos_t = np.cos(np.radians(prob.contact_angle))
-        self.pcap = np.where(grid.island, 0.0,
-                             -2.0 * prob.surface_tension * cos_t / np.where(grid.island, 1.0,
-                                                                              self.h))
+        self.theta_s = np.radians(prob.contact_angle)
+        cos_t = np.cos(self.theta_s)
         if prob.receding_meniscus == "bretherton":   # the pull where the walls leave at u
             ca = prob.viscosity * u / prob.surface_tension
             self.pull = (1.0 + 3.8 * ca ** (2.0 / 3.0)) / cos_t
@@ -416,7 +414,6 @@ class _Operators:
         on_track = np.clip((prob.track_half_width - (grid.y - d / 2)) / d, 0.0, 1.0)
         self.q_supply = u * prob.supply * on_track * d  # into column 0 [m3/s]
         self.young_laplace = 2.0 * prob.surface_tension * cos_t   # pcap = -it / h [N/m]
-        self.theta_s = np.radians(prob.contact_angle)
         self.theta_a = None if prob.advancing_angle is None else np.radians(prob.advancing_angle)
         self.dry = 1.0 - on_track[:, None]             # walls coming in dry: off the track
         self.sub_cell = prob.meniscus_position == "sub-cell"
@@ -460,7 +457,7 @@ class _Operators:
         sits theta cells from the flooded cell's centre, at the gap there (linear between
         the two centres), conductance g / theta: sub-cell, theta = 1/2 + the open cell's
         fill; cell, theta = 1 (the open cell's centre). Its pressure: Young-Laplace's,
-        times the receding pull."""
+        times the dynamic menisci's factor (``pull_factor``)."""
         factor = np.broadcast_to(self.pull_factor(flooded), flooded.shape)
         theta = 0.5 + self.fill(c) if self.sub_cell else np.ones_like(c)
         per_axis = {}
