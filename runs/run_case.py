@@ -535,8 +535,10 @@ def front_cell_warnings(front_cells: float | None) -> list[str]:
     return [f"the flooded region's front off the track, where dry walls run into it, sits in "
             f"in-plane cells {front_cells:.0f} times its wall cells (above "
             f"{FRONT_CELL_WARNING:g}): there interFoam gives the advancing contact line no "
-            f"capillary suction, and the flooded width is not converged; docs/cases.md, \"The "
-            f"region's sides are moving contact lines\""]
+            f"capillary suction, and neither the flooded width nor the inlet meniscus is "
+            f"converged (on the coarse walls resolving it moved the inlet meniscus 12 % "
+            f"downstream); docs/cases.md, \"The region's sides are moving contact lines\", "
+            f"\"The front arc resolved\""]
 
 
 def _final_metrics(spec, geom: CaseGeometry, structure, v0, history, reason, failed, rc, tail, wall,
