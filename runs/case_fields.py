@@ -183,6 +183,12 @@ def smeared_oil_fraction(alpha: np.ndarray, cell_volumes: np.ndarray) -> float |
     return float(oil[(a > lo) & (a < hi)].sum()) / total
 
 
+def read_alpha(path: Path, structure: Structure) -> np.ndarray:
+    """The oil fraction per cell of the alpha.oil file ``path``, once OpenFOAM has finished
+    writing it (raises ValueError while it has not)."""
+    return _read_alpha(_complete(path), structure)[0]
+
+
 def mid_gap_alpha(folder: Path, structure: Structure, geom: CaseGeometry) -> np.ndarray:
     """The oil fraction at mid-gap of the time folder ``folder``, per base cell."""
     return structure.mid_gap(_read_alpha(folder / "alpha.oil", structure)[0], geom.n_layers)

@@ -877,3 +877,37 @@ def test_meniscus_pressure_reads_a_known_jump_off_written_fields(small_case, tmp
         assert ray["jump_Pa"] == pytest.approx(suction, rel=1e-6), ray
         # the reference is read at the meniscus found: within a cell of r = 3 a
         assert ray["jump_over_laplace"] == pytest.approx(1.0, abs=2 * 1.5 * cell / 3.0), ray
+
+
+def test_oil_change_splits_a_known_change_by_class_and_position(small_case, tmp_path):
+    """bench/oil_change.py on two writes by hand: oil wall to wall inside r = 2 a, then inside
+    r = 3 a with a film (the disc's layer of cells) outside r = 4 a. The ring 2-3 a is
+    'flooded', the film 'outside', nothing else changes; the volumes are the cells' own."""
+    from bench.oil_change import oil_change
+
+    case = _copy(small_case, tmp_path)
+    geom = load_geometry(case)
+    st = case_fields.Structure.load(case)
+    r = np.hypot(st.base_x, st.base_y)[st.base_cell] / geom.a
+    before = (r < 2.0).astype(float)
+    after = ((r < 3.0) | ((r > 4.0) & (st.layer == 0))).astype(float)
+    for t, values in ((1e-3, before), (2e-3, after)):
+        folder = case / f"{t:g}"
+        folder.mkdir()
+        shutil.copy(case / "0.orig" / "alpha.oil", folder / "alpha.oil")
+        FoamFieldFile(folder / "alpha.oil").internal_field = values
+    res = oil_change(case, str(1e-3 / geom.transit_time), "last")
+    assert (res["time_1_s"], res["time_2_s"]) == pytest.approx((1e-3, 2e-3))
+    nl = lambda sel: geom.mirror * st.cell_volumes[sel].sum() / 1e-12  # noqa: E731
+    ring = (r >= 2.0) & (r < 3.0)
+    film = (r > 4.0) & (st.layer == 0)
+    by = res["by_class"]
+    assert res["change_nl"] == pytest.approx(nl(ring) + nl(film), rel=1e-9)
+    assert by["flooded"]["total_nl"] == pytest.approx(nl(ring), rel=1e-9)
+    assert by["outside"]["total_nl"] == pytest.approx(nl(film), rel=1e-9)
+    assert by["inside"]["total_nl"] == by["drained"]["total_nl"] == 0.0
+    x = st.base_x[st.base_cell] / geom.a
+    assert by["flooded"]["behind (x > a)"] == pytest.approx(nl(ring & (x > 1.0)), rel=1e-9)
+    assert by["flooded"]["behind (x > a)"] > 0.0
+    on_track = np.abs(st.base_y[st.base_cell]) <= geom.a * res["track_half_width_over_a"]
+    assert by["outside"]["on_track_nl"] == pytest.approx(nl(film & on_track), rel=1e-9)
