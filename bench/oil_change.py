@@ -9,13 +9,15 @@ fraction (0.5) at the two writes:
   the oil does not fill them wall to wall, e.g. air along a wall or a smeared interface),
 - ``flooded``: air, then oil (the region grew over them),
 - ``drained``: oil, then air,
-- ``outside``: air at both (the films on the walls outside the region),
+- ``outside``: air at both (the meniscus's own columns, with oil along the walls under air at
+  mid-gap, and the films on the walls further out; the ``outside`` change is also given by
+  the column's distance from the region at T2, in bins of ``DISTANCES`` a),
 
 and, across the classes, by position: ahead of the contact (x < -a), beside it (|x| <= a),
 behind it (x > a), and on the track (|y| <= its half-width) or off it. Volumes are of the
 whole contact (doubled in a half domain), in nl. Both writes must be on the same mesh.
 
-    python bench/oil_change.py CASE T1 T2 [--plot OUT.png] [--window X0,X1,Y0,Y1] [--save NAME.json]
+    python bench/oil_change.py CASE T1 T2 [--plot OUT.png] [--window=X0,X1,Y0,Y1] [--save NAME.json]
 
 T1, T2 in transits (the write nearest each; ``last`` for the last write).
 """
@@ -27,6 +29,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
@@ -37,6 +40,8 @@ from runs import case_fields  # noqa: E402
 
 NL = 1e-12  # m3 per nanolitre
 CLASSES = ("inside", "flooded", "drained", "outside")
+#: bin edges [a] of the outside columns' distance from the nearest column with oil at mid-gap
+DISTANCES = (0.0, 0.5, 1.0, 2.0, 4.0, np.inf)
 
 
 def write_near(case: Path, at: str) -> tuple[float, Path]:
@@ -89,13 +94,22 @@ def oil_change(case: Path, t1: str, t2: str, track_half_width: float | None = No
         row.update({k: float(d[sel & m].sum()) for k, m in where.items()})
         row["columns"] = int(sel.sum())
         table[c] = row
+    outside = cls == "outside"
+    xy = np.stack([st.base_x, st.base_y], 1) / g.a
+    dist = cKDTree(xy[wet_b]).query(xy)[0] if wet_b.any() else np.full(len(d), np.inf)
+    profile = []
+    for lo, hi in zip(DISTANCES[:-1], DISTANCES[1:]):
+        sel = outside & (dist >= lo) & (dist < hi)
+        profile.append({"from_over_a": lo, "to_over_a": hi, "columns": int(sel.sum()),
+                        "total_nl": float(d[sel].sum()),
+                        "behind_nl": float(d[sel & (x > 1.0)].sum())})
     return {
         "case": str(case), "time_1_s": ta, "time_2_s": tb,
         "transits_1": ta / g.transit_time, "transits_2": tb / g.transit_time,
         "oil_1_nl": float(oil_a.sum() * g.mirror / NL),
         "oil_2_nl": float(oil_b.sum() * g.mirror / NL),
         "change_nl": float(d.sum()), "by_class": table,
-        "track_half_width_over_a": track_half_width / g.a,
+        "outside_by_distance": profile, "track_half_width_over_a": track_half_width / g.a,
         "_columns": {"x": x, "y": st.base_y / g.a, "d_nl": d, "area": st.footprint,
                      "mid_1": mid_a, "mid_2": mid_b, "a": g.a, "mirror": g.mirror},
     }
@@ -148,6 +162,9 @@ def report(r: dict) -> str:
     for c, row in r["by_class"].items():
         vals = [v for k, v in row.items() if k != "columns"]
         lines.append(" | ".join([c, str(row["columns"]), *(f"{v:+.2f}" for v in vals)]))
+    lines.append("outside, by distance from the region: " + ", ".join(
+        f"{b['from_over_a']:g}-{b['to_over_a']:g} a {b['total_nl']:+.2f} nl "
+        f"({b['behind_nl']:+.2f} behind)" for b in r["outside_by_distance"]))
     return "\n".join(lines)
 
 

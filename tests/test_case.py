@@ -911,3 +911,7 @@ def test_oil_change_splits_a_known_change_by_class_and_position(small_case, tmp_
     assert by["flooded"]["behind (x > a)"] > 0.0
     on_track = np.abs(st.base_y[st.base_cell]) <= geom.a * res["track_half_width_over_a"]
     assert by["outside"]["on_track_nl"] == pytest.approx(nl(film & on_track), rel=1e-9)
+    # the film starts 1 a beyond the edge of the region (r = 3 a): none of it within 1 a
+    profile = res["outside_by_distance"]
+    assert sum(b["total_nl"] for b in profile) == pytest.approx(nl(film), rel=1e-9)
+    assert [b["total_nl"] for b in profile[:2]] == [0.0, 0.0]
