@@ -35,6 +35,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
+from bench.plot_midgap import dress_top_view, parse_window  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
 from runs import case_fields  # noqa: E402
 
@@ -111,7 +112,7 @@ def oil_change(case: Path, t1: str, t2: str, track_half_width: float | None = No
         "change_nl": float(d.sum()), "by_class": table,
         "outside_by_distance": profile, "track_half_width_over_a": track_half_width / g.a,
         "_columns": {"x": x, "y": st.base_y / g.a, "d_nl": d, "area": st.footprint,
-                     "mid_1": mid_a, "mid_2": mid_b, "a": g.a, "mirror": g.mirror},
+                     "mid_1": mid_a, "mid_2": mid_b, "mirror": g.mirror, "geometry": g},
     }
 
 
@@ -133,17 +134,11 @@ def plot(out: Path, r: dict, window) -> None:
         m1, m2 = c["mid_1"], c["mid_2"]
     lim = float(np.percentile(np.abs(thick), 99.5)) or 1.0
     fig, ax = plt.subplots(figsize=(9, 5.5))
-    sc = ax.tricontourf(x, y, np.clip(thick, -lim, lim), levels=np.linspace(-lim, lim, 21), extend="both",
-                        cmap="RdBu_r")
+    sc = ax.tricontourf(x, y, np.clip(thick, -lim, lim), levels=np.linspace(-lim, lim, 21),
+                        extend="both", cmap="RdBu_r")
     ax.tricontour(x, y, m1, levels=[0.5], colors="0.4", linewidths=0.8, linestyles="--")
     ax.tricontour(x, y, m2, levels=[0.5], colors="k", linewidths=0.9)
-    ax.add_patch(plt.Circle((0, 0), 1.0, color="r", fill=False, lw=1))
-    ax.set_aspect("equal")
-    if window is not None:
-        ax.set_xlim(*window[:2])
-        ax.set_ylim(*window[2:])
-    ax.set_xlabel("x / a (rolling ->)")
-    ax.set_ylabel("y / a")
+    dress_top_view(ax, c["geometry"], window)
     ax.set_title(f"oil gained per column, transits {r['transits_1']:.1f} -> "
                  f"{r['transits_2']:.1f}: {r['oil_1_nl']:.1f} -> {r['oil_2_nl']:.1f} nl "
                  f"(meniscus dashed before, solid after)", fontsize=9)
@@ -177,11 +172,7 @@ def main(argv=None) -> int:
     p.add_argument("--window", help="X0,X1,Y0,Y1 in units of a, for the plot")
     p.add_argument("--save", help="record name under bench/results/")
     args = p.parse_args(argv)
-    window = None
-    if args.window:
-        window = [float(v) for v in args.window.split(",")]
-        if len(window) != 4:
-            raise SystemExit(f"oil_change: --window {args.window!r} needs X0,X1,Y0,Y1")
+    window = parse_window(args.window) if args.window else None
     r = oil_change(args.case, args.t1, args.t2)
     print(report(r))
     if args.plot:

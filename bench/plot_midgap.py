@@ -43,7 +43,7 @@ def main(argv=None) -> int:
         if rest[0] == "--overlay":
             overlay, rest = True, rest[1:]
         elif len(rest) > 2:
-            window, rest = _window(rest[1]), rest[2:]
+            window, rest = parse_window(rest[1]), rest[2:]
         else:
             raise SystemExit("plot_midgap: --window needs X0,X1,Y0,Y1 and at least one case")
     picks = [_pick(arg) for arg in rest]
@@ -74,7 +74,7 @@ def main(argv=None) -> int:
                      f"({m.get('inlet_meniscus_shape') or '-'})"
                      + (f", bubble {fmt(m.get('bubble_length_over_a'))} a"
                         if m.get("bubble_length_over_a") else ""), fontsize=8)
-        _dress(ax, g, window)
+        dress_top_view(ax, g, window)
     fig.colorbar(tc, ax=axs.ravel().tolist(), label="oil fraction at mid-gap",
                  orientation="horizontal", fraction=0.02 if len(picks) > 1 else 0.05,
                  pad=0.04 if len(picks) > 1 else 0.2)
@@ -113,7 +113,7 @@ def _overlay(out: Path, picks: list[tuple[Path, float | None]], window) -> int:
         ax.tricontour(x, y, mid, levels=[0.5], colors=c, linewidths=1.2)
         ax.plot([], [], color=c, label=f"{case.parent.name}/{case.name}, t = {t * 1e3:.0f} ms"
                 + (f", width {width:.2f} a" if width is not None else ""))
-    _dress(ax, g, window)
+    dress_top_view(ax, g, window)
     ax.set_title("menisci at mid-gap (oil fraction 0.5)", fontsize=9)
     ax.legend(fontsize=7, loc="lower left")
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -122,7 +122,7 @@ def _overlay(out: Path, picks: list[tuple[Path, float | None]], window) -> int:
     return 0
 
 
-def _dress(ax, g, window) -> None:
+def dress_top_view(ax, g, window) -> None:
     """The island (black), the Hertzian circle (red), equal axes in units of a, the window."""
     import matplotlib.pyplot as plt
 
@@ -136,14 +136,14 @@ def _dress(ax, g, window) -> None:
     ax.set_ylabel("y / a")
 
 
-def _window(arg: str) -> tuple[float, float, float, float]:
+def parse_window(arg: str) -> tuple[float, float, float, float]:
     """"X0,X1,Y0,Y1" (in units of a) -> the four limits, checked."""
     try:
         x0, x1, y0, y1 = (float(v) for v in arg.split(","))
     except ValueError:
-        raise SystemExit(f"plot_midgap: --window {arg!r}: expected four numbers X0,X1,Y0,Y1 (in a)")
+        raise SystemExit(f"--window {arg!r}: expected four numbers X0,X1,Y0,Y1 (in a)")
     if not (x0 < x1 and y0 < y1):
-        raise SystemExit(f"plot_midgap: --window {arg!r}: needs X0 < X1 and Y0 < Y1")
+        raise SystemExit(f"--window {arg!r}: needs X0 < X1 and Y0 < Y1")
     return x0, x1, y0, y1
 
 
