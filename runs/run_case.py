@@ -503,10 +503,12 @@ def rear_cell_warnings(rear_cell: float | None) -> list[str]:
     if rear_cell is None or rear_cell <= REAR_CELL_WARNING:
         return []
     return [f"the rear meniscus sits in {rear_cell:.2f} a cells (above {REAR_CELL_WARNING:g} a): "
-            f"they lay wall films thicker than Landau-Levich's and the flooded width comes out "
-            f"short (the default levels' by 11-20 % against the finest runs); refine over the rear "
-            f"(mesh.refine, as in runs/nominal_films.toml); docs/cases.md, \"One step finer at "
-            f"the rear meniscus\""]
+            f"they lay wall films thicker than Landau-Levich's and set how much oil leaves the "
+            f"region (0.7 -> 0.06 a there halved the coarse level's outflow), so the oil it holds "
+            f"and its width are off (the default levels' width by 11-20 % against the finest "
+            f"runs); refine over the rear (mesh.refine, as in runs/nominal_films.toml); "
+            f"docs/cases.md, \"One step finer at the rear meniscus\", \"The oil goes to the "
+            f"rear meniscus\""]
 
 
 def front_contact_line_cells(spec: CaseSpec, geom: CaseGeometry,
