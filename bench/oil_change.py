@@ -41,12 +41,15 @@ from runs import case_fields  # noqa: E402
 
 NL = 1e-12  # m3 per nanolitre
 CLASSES = ("inside", "flooded", "drained", "outside")
+#: where a column is, by x / a
+POSITIONS = ("ahead (x < -a)", "beside (|x| <= a)", "behind (x > a)")
 #: bin edges [a] of the outside columns' distance from the nearest column with oil at mid-gap
 DISTANCES = (0.0, 0.5, 1.0, 2.0, 4.0, np.inf)
 
 
-def write_near(case: Path, at: str) -> tuple[float, Path]:
-    """(time [s], folder) of the write nearest ``at`` transits, or the last for "last"."""
+def write_near(case: Path, at: str, transit_time: float) -> tuple[float, Path]:
+    """(time [s], folder) of the write nearest ``at`` transits (of ``transit_time`` s), or the
+    last for "last"."""
     times = case_fields.time_folders(case)
     if not times:
         raise SystemExit(f"oil_change: {case} has no time folders")
@@ -56,11 +59,11 @@ def write_near(case: Path, at: str) -> tuple[float, Path]:
         transits = float(at)
     except ValueError:
         raise SystemExit(f"oil_change: T = {at!r} must be a number of transits or 'last'")
-    g = load_geometry(case)
-    return min(times, key=lambda tf: abs(tf[0] - transits * g.transit_time))
+    return min(times, key=lambda tf: abs(tf[0] - transits * transit_time))
 
 
-def columns(folder: Path, st: case_fields.Structure, n_layers: int) -> tuple[np.ndarray, np.ndarray]:
+def columns(folder: Path, st: case_fields.Structure,
+            n_layers: int) -> tuple[np.ndarray, np.ndarray]:
     """(oil per column [m3], mid-gap oil fraction) per base cell of the write ``folder``."""
     alpha = np.clip(case_fields.read_alpha(folder / "alpha.oil", st), 0.0, 1.0)
     n_base = len(st.base_x)
@@ -73,7 +76,7 @@ def oil_change(case: Path, t1: str, t2: str, track_half_width: float | None = No
     and position (module docstring); also the per-column arrays for a plot (key "_columns")."""
     g = load_geometry(case)
     st = case_fields.Structure.load(case)
-    (ta, fa), (tb, fb) = write_near(case, t1), write_near(case, t2)
+    (ta, fa), (tb, fb) = (write_near(case, t, g.transit_time) for t in (t1, t2))
     oil_a, mid_a = columns(fa, st, g.n_layers)
     oil_b, mid_b = columns(fb, st, g.n_layers)
     if track_half_width is None:
@@ -83,8 +86,7 @@ def oil_change(case: Path, t1: str, t2: str, track_half_width: float | None = No
     cls = np.select([wet_a & wet_b, ~wet_a & wet_b, wet_a & ~wet_b], CLASSES[:3], CLASSES[3])
     d = (oil_b - oil_a) * g.mirror / NL
     x, y = st.base_x / g.a, np.abs(st.base_y) / g.a
-    where = {"ahead (x < -a)": x < -1.0, "beside (|x| <= a)": np.abs(x) <= 1.0,
-             "behind (x > a)": x > 1.0}
+    where = dict(zip(POSITIONS, (x < -1.0, np.abs(x) <= 1.0, x > 1.0)))
     track = y <= track_half_width / g.a
     table = {}
     for c in CLASSES:
@@ -149,13 +151,13 @@ def plot(out: Path, r: dict, window) -> None:
 
 
 def report(r: dict) -> str:
-    head = ["class", "columns", "total", "on track", "off track", *list(
-        next(iter(r["by_class"].values())).keys())[3:-1]]
+    head = ["class", "columns", "total", "on track", "off track", *POSITIONS]
     lines = [f"{r['case']}: transits {r['transits_1']:.2f} -> {r['transits_2']:.2f}, oil "
              f"{r['oil_1_nl']:.2f} -> {r['oil_2_nl']:.2f} nl ({r['change_nl']:+.2f} nl)",
              " | ".join(head)]
     for c, row in r["by_class"].items():
-        vals = [v for k, v in row.items() if k != "columns"]
+        vals = [row["total_nl"], row["on_track_nl"], row["off_track_nl"],
+                *(row[k] for k in POSITIONS)]
         lines.append(" | ".join([c, str(row["columns"]), *(f"{v:+.2f}" for v in vals)]))
     lines.append("outside, by distance from the region: " + ", ".join(
         f"{b['from_over_a']:g}-{b['to_over_a']:g} a {b['total_nl']:+.2f} nl "
