@@ -24,7 +24,6 @@ T1, T2 in transits (the write nearest each; ``last`` for the last write).
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -36,7 +35,7 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from bench.plot_midgap import dress_top_view, parse_window  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
+from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
 from runs import case_fields  # noqa: E402
 
 NL = 1e-12  # m3 per nanolitre
@@ -80,8 +79,7 @@ def oil_change(case: Path, t1: str, t2: str, track_half_width: float | None = No
     oil_a, mid_a = columns(fa, st, g.n_layers)
     oil_b, mid_b = columns(fb, st, g.n_layers)
     if track_half_width is None:
-        spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
-        track_half_width = float(spec["supply"]["track_half_width"])
+        track_half_width = load_spec_of(case).supply.track_half_width
     wet_a, wet_b = mid_a > 0.5, mid_b > 0.5
     cls = np.select([wet_a & wet_b, ~wet_a & wet_b, wet_a & ~wet_b], CLASSES[:3], CLASSES[3])
     d = (oil_b - oil_a) * g.mirror / NL

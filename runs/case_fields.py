@@ -256,8 +256,7 @@ def advancing_front_cells(folder: Path, structure: Structure, geom: CaseGeometry
     the column there (the square root of its area) over its wall cell's height. A contact line
     advancing onto dry walls holds a capillary suction only where that is within some 15
     (``bench/contact_line_strip.py``). Empty without such an edge."""
-    alpha, _ = _read_alpha(_complete(folder / "alpha.oil"), structure)
-    mid = structure.mid_gap(alpha, geom.n_layers)
+    mid = structure.mid_gap(read_alpha(folder / "alpha.oil", structure), geom.n_layers)
     r = metrics.raster(structure.base_x, structure.base_y, mid, pattern_geometry(geom))
     points = metrics.advancing_front(r, track_half_width)
     if not len(points):
