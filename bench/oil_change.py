@@ -46,21 +46,6 @@ POSITIONS = ("ahead (x < -a)", "beside (|x| <= a)", "behind (x > a)")
 DISTANCES = (0.0, 0.5, 1.0, 2.0, 4.0, np.inf)
 
 
-def write_near(case: Path, at: str, transit_time: float) -> tuple[float, Path]:
-    """(time [s], folder) of the write nearest ``at`` transits (of ``transit_time`` s), or the
-    last for "last"."""
-    times = case_fields.time_folders(case)
-    if not times:
-        raise SystemExit(f"oil_change: {case} has no time folders")
-    if at == "last":
-        return times[-1]
-    try:
-        transits = float(at)
-    except ValueError:
-        raise SystemExit(f"oil_change: T = {at!r} must be a number of transits or 'last'")
-    return min(times, key=lambda tf: abs(tf[0] - transits * transit_time))
-
-
 def columns(folder: Path, st: case_fields.Structure,
             n_layers: int) -> tuple[np.ndarray, np.ndarray]:
     """(oil per column [m3], mid-gap oil fraction) per base cell of the write ``folder``."""
@@ -75,7 +60,7 @@ def oil_change(case: Path, t1: str, t2: str, track_half_width: float | None = No
     and position (module docstring); also the per-column arrays for a plot (key "_columns")."""
     g = load_geometry(case)
     st = case_fields.Structure.load(case)
-    (ta, fa), (tb, fb) = (write_near(case, t, g.transit_time) for t in (t1, t2))
+    (ta, fa), (tb, fb) = (case_fields.write_near(case, t, g.transit_time) for t in (t1, t2))
     oil_a, mid_a = columns(fa, st, g.n_layers)
     oil_b, mid_b = columns(fb, st, g.n_layers)
     if track_half_width is None:
@@ -173,7 +158,10 @@ def main(argv=None) -> int:
     p.add_argument("--save", help="record name under bench/results/")
     args = p.parse_args(argv)
     window = parse_window(args.window) if args.window else None
-    r = oil_change(args.case, args.t1, args.t2)
+    try:
+        r = oil_change(args.case, args.t1, args.t2)
+    except ValueError as err:
+        raise SystemExit(f"oil_change: {err}")
     print(report(r))
     if args.plot:
         plot(args.plot, r, window)

@@ -39,11 +39,14 @@ its valid range, before anything is written.
 from __future__ import annotations
 
 import math
+from functools import cached_property
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal, Union, get_args
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError,
+                      field_validator, model_validator)
+from scipy.spatial import cKDTree
 
 from ehl_precalc.spec import PrecalcSpec, SpecError, range_text, read_toml
 
@@ -252,6 +255,61 @@ class RefineBox(BaseModel):
         return self.size + REFINE_GROWTH * np.hypot(dx, dy)
 
 
+class RefineBand(BaseModel):
+    """A band of finer in-plane cells along a line (``mesh.refine``), units of a: within
+    ``half_width`` of the polyline through ``points`` ((x, |y|) pairs, so a half domain's
+    line serves the full domain too), cells of ``size``, growing back to the level's size at
+    :data:`REFINE_GROWTH` further out. Like a box it refines the free quads only.
+    ``ehlfoam band CASE`` writes the bands that follow a run's mid-gap meniscus, so that a
+    continued run has its whole meniscus in cells of a chosen size (docs/cases.md, "A band
+    along the meniscus")."""
+
+    model_config = _STRICT
+    points: tuple[tuple[float, float], ...] = Field(min_length=2, max_length=10_000)
+    half_width: float = Field(gt=0.0, le=20.0)
+    size: float = Field(gt=0.0, le=10.0)
+
+    @field_validator("points")
+    @classmethod
+    def _points_in_range(cls, points: tuple[tuple[float, float], ...]):
+        for x, y in points:
+            if not (-200.0 <= x <= 200.0 and 0.0 <= y <= 200.0):
+                raise ValueError(f"point ({x:g}, {y:g}) a lies outside -200 <= x <= 200, "
+                                 "0 <= y <= 200 (units of a, y = |y|)")
+        return points
+
+    @cached_property
+    def _tree(self) -> cKDTree:
+        """The line sampled every quarter of the smaller of size and half-width: the distance
+        to the samples is the distance to the line within an eighth of that."""
+        p = np.asarray(self.points, float)
+        step = 0.25 * min(self.size, self.half_width)
+        seg = np.diff(p, axis=0)
+        n = np.maximum(np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / step).astype(int), 1)
+        samples = [p[i] + np.outer(np.arange(k) / k, seg[i]) for i, k in enumerate(n)]
+        return cKDTree(np.vstack(samples + [p[-1:]]))
+
+    def size_at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Cell size (a) this band asks for at (x, y) (a): its size within half_width of
+        its line, growing with the distance further out."""
+        x, y = np.broadcast_arrays(np.asarray(x, float), np.abs(np.asarray(y, float)))
+        dist, _ = self._tree.query(np.stack([x.ravel(), y.ravel()], axis=1))
+        beyond = np.maximum(dist.reshape(x.shape) - self.half_width, 0.0)
+        return self.size + REFINE_GROWTH * beyond
+
+
+def _refine_kind(value: Any) -> str:
+    """Which kind of refinement a ``mesh.refine`` entry is: a band has points."""
+    if isinstance(value, dict):
+        return "band" if "points" in value else "box"
+    return "band" if isinstance(value, RefineBand) else "box"
+
+
+#: an entry of ``mesh.refine``: a box, or a band along a line
+Refinement = Annotated[Union[Annotated[RefineBox, Tag("box")], Annotated[RefineBand, Tag("band")]],
+                       Discriminator(_refine_kind)]
+
+
 class Mesh(BaseModel):
     """Resolution level (see :data:`RESOLUTIONS`) and optional overrides.
 
@@ -274,10 +332,13 @@ class Mesh(BaseModel):
             column so that it meets every layer at right angles (an in-plane shift of a
             few um at most), "vertical" keeps them upright, which makes every face where
             the ball slopes non-orthogonal (docs/cases.md, "Columns across the gap").
-        refine: boxes of finer in-plane cells (:class:`RefineBox`), e.g.
-            ``[{x_min = 5, x_max = 14, y_max = 8, size = 0.1}]`` where the rear meniscus and
-            the region's shoulders sit: the films they lay converge only in cells of 0.05-0.1
-            a (docs/cases.md, "The films decide the width"). Empty by default.
+        refine: boxes (:class:`RefineBox`) and bands along a line (:class:`RefineBand`) of
+            finer in-plane cells, e.g. ``[{x_min = 5, x_max = 14, y_max = 8, size = 0.1}]``
+            where the rear meniscus and the region's shoulders sit: the films they lay
+            converge only in cells of 0.05-0.1 a (docs/cases.md, "The films decide the
+            width"), and an advancing meniscus on dry walls holds its suction only in cells
+            within some 15 wall cells ("The region's sides are moving contact lines").
+            ``ehlfoam band CASE`` writes bands along a run's meniscus. Empty by default.
     """
 
     model_config = _STRICT
@@ -288,7 +349,7 @@ class Mesh(BaseModel):
     wall_grading: float | None = Field(None, ge=1.0, le=100.0)
     polar_radius: float | Literal["auto"] | None = "auto"
     columns: Literal["normal", "vertical"] = "normal"
-    refine: tuple[RefineBox, ...] = ()
+    refine: tuple[Refinement, ...] = ()
 
     @field_validator("polar_radius", mode="before")
     @classmethod
@@ -501,17 +562,43 @@ def _drop_none(value):
 
 
 # ------------------------------------------------------------------ errors
+#: the tags pydantic puts in an error's location inside a tagged union (``mesh.refine``)
+_UNION_TAGS = {"box": RefineBox, "band": RefineBand}
+
+
+def _models_in(annotation: Any) -> list[type[BaseModel]]:
+    """The model classes an annotation holds (itself, or inside a tuple, union, Annotated)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    return [m for arg in get_args(annotation) for m in _models_in(arg)]
+
+
+def _spec_loc(loc: tuple) -> tuple:
+    """An error location as the spec names it: without the tag of a union member
+    (``mesh.refine.0.band.size`` -> ``mesh.refine.0.size``)."""
+    return tuple(p for i, p in enumerate(loc)
+                 if not (p in _UNION_TAGS and i > 0 and isinstance(loc[i - 1], int)))
+
+
 def _field_at(model: type[BaseModel], loc: tuple) -> tuple[type[BaseModel] | None, Any]:
-    """The model class and field info that a pydantic error location points at."""
-    for i, part in enumerate(loc):
+    """The model class and field info that a pydantic error location points at (through
+    tuples of models and tagged unions of them)."""
+    field = None
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        if part in _UNION_TAGS and field is not None:
+            model, field = _UNION_TAGS[part], None
+            continue
+        if field is not None:
+            inner = _models_in(field.annotation)
+            if len(inner) != 1:
+                return model, None
+            model = inner[0]
         field = model.model_fields.get(str(part))
         if field is None:
             return model, None
-        ann = field.annotation
-        if i == len(loc) - 1 or not (isinstance(ann, type) and issubclass(ann, BaseModel)):
-            return model, field
-        model = ann
-    return model, None
+    return model, field
 
 
 def format_errors(err: ValidationError, root: type[BaseModel] = None) -> str:
@@ -520,7 +607,7 @@ def format_errors(err: ValidationError, root: type[BaseModel] = None) -> str:
     lines = []
     for e in err.errors():
         loc = tuple(e["loc"])
-        name = ".".join(str(p) for p in loc) or "spec"
+        name = ".".join(str(p) for p in _spec_loc(loc)) or "spec"
         msg = e["msg"].removeprefix("Value error, ")
         model, field = _field_at(root, loc)
         if e["type"] == "extra_forbidden":

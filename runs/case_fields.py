@@ -102,6 +102,21 @@ def time_folders(case: str | os.PathLike) -> list[tuple[float, Path]]:
     return sorted(out)
 
 
+def write_near(case: str | os.PathLike, at: str, transit_time: float) -> tuple[float, Path]:
+    """(time [s], folder) of the write nearest ``at`` transits (of ``transit_time`` s), or the
+    last write for ``at = "last"``. Raises ValueError naming what is wrong."""
+    times = time_folders(case)
+    if not times:
+        raise ValueError(f"{case} has no written time folders")
+    if at == "last":
+        return times[-1]
+    try:
+        transits = float(at)
+    except ValueError:
+        raise ValueError(f"time = {at!r} must be a number of transits or 'last'") from None
+    return min(times, key=lambda tf: abs(tf[0] - transits * transit_time))
+
+
 def _uniform_or_list(value, n: int) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
     if arr.ndim == 0:

@@ -5,6 +5,7 @@ Subcommands:
   precalc  the EHL pre-calculation, registered by ``ehl_precalc.cli``
   case     write an OpenFOAM case from a TOML case spec
   run      run a case to steady state and write its metrics.json
+  band     bands of finer cells along a run's meniscus (for mesh.refine)
   report   an HTML report (pictures, plots, metrics) of a case or a batch
   batch    generate, run and report a batch of cases (sweeps, speed ramps)
 
@@ -18,7 +19,7 @@ import sys
 from collections.abc import Sequence
 
 from ehl_precalc import cli as precalc_cli
-from runs import batch_cli
+from runs import batch_cli, meniscus_band
 from runs.report import add_parser as _report_add_parser
 from runs.foam_runtime import (
     FoamConfigError,
@@ -210,6 +211,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--quiet", action="store_true", help="no line per written time")
     run.set_defaults(func=cmd_run)
 
+    meniscus_band.add_parser(sub)
     _report_add_parser(sub)
     batch_cli.add_parser(sub)
     return parser

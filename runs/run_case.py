@@ -506,7 +506,8 @@ def rear_cell_warnings(rear_cell: float | None) -> list[str]:
             f"they lay wall films thicker than Landau-Levich's and set how much oil leaves the "
             f"region (0.7 -> 0.06 a there halved the coarse level's outflow), so the oil it holds "
             f"and its width are off (the default levels' width by 11-20 % against the finest "
-            f"runs); refine over the rear (mesh.refine, as in runs/nominal_films.toml); "
+            f"runs); refine over the rear (mesh.refine: a box as in runs/nominal_films.toml, or "
+            f"a band along this run's meniscus from `ehlfoam band CASE`); "
             f"docs/cases.md, \"One step finer at the rear meniscus\", \"The oil goes to the "
             f"rear meniscus\""]
 
@@ -539,8 +540,10 @@ def front_cell_warnings(front_cells: float | None) -> list[str]:
             f"{FRONT_CELL_WARNING:g}): there interFoam gives the advancing contact line no "
             f"capillary suction, and neither the flooded width nor the inlet meniscus is "
             f"converged (on the coarse walls resolving it moved the inlet meniscus 12 % "
-            f"downstream); docs/cases.md, \"The region's sides are moving contact lines\", "
-            f"\"The front arc resolved\""]
+            f"downstream); continue the run on a mesh with a band along its meniscus "
+            f"(`ehlfoam band CASE --size S --half-width 1` into mesh.refine, S within "
+            f"{FRONT_CELL_WARNING:g} wall cells); docs/cases.md, \"The region's sides are moving "
+            f"contact lines\", \"A band along the meniscus\""]
 
 
 def _final_metrics(spec, geom: CaseGeometry, structure, v0, history, reason, failed, rc, tail, wall,

@@ -216,6 +216,75 @@ def test_a_refinement_box_refines_the_free_quads_inside_it():
         make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": [{**box, "y_min": 5.0}]}})
 
 
+def test_a_band_refines_the_free_quads_along_its_line():
+    """mesh.refine with points: quads of the band's size within half_width of its line, the
+    level's far from it; the line is read as (x, |y|); a band with one point or below y = 0
+    is refused, naming it."""
+    from generator.case_spec import REFINE_GROWTH
+    from generator.case_writer import size_function
+    from generator.mesh import MeshParams, build_base_mesh
+
+    # a quarter circle of r = 3 a from the upstream axis round to x = 0 (points every 0.3 a)
+    phi = np.linspace(np.pi, np.pi / 2, 17)
+    band = {"points": [[3 * np.cos(f), 3 * np.sin(f)] for f in phi], "half_width": 0.6,
+            "size": 0.2}
+    free = {**SMALL["mesh"], "polar_radius": None}            # free quads: the band's cells
+    spec = make_case_spec({**SMALL, "mesh": {**free, "refine": [band]}})
+    size, a = size_function(spec), spec.a
+    assert size(-3.0 * a, 0.0) == pytest.approx(0.2 * a)
+    assert size(-2.1 * a, -2.1 * a) == pytest.approx(0.2 * a)       # r = 2.97 a, below y = 0
+    beyond = np.hypot(4.0, 0.5) - 3.0 - 0.6                         # from the band's edge
+    assert size(-4.0 * a, 0.5 * a) == pytest.approx((0.2 + REFINE_GROWTH * beyond) * a, rel=0.01)
+    plain = make_case_spec({**SMALL, "mesh": free})
+    assert size(3.0 * a, 0.0) == pytest.approx(size_function(plain)(3.0 * a, 0.0))
+    d = spec.domain
+    params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
+                        island_radius=d.island_radius * a, n_layers=2, polar_radius=None)
+    mesh = build_base_mesh(params, size)
+    c = mesh.points[mesh.quads].mean(axis=1) / a
+    cell = np.sqrt(mesh.quad_areas()) / a
+    r = np.hypot(c[:, 0], c[:, 1])
+    on_band = (np.abs(r - 3.0) < 0.4) & (c[:, 0] < -0.5)
+    assert on_band.sum() > 20
+    assert np.median(cell[on_band]) == pytest.approx(0.2, rel=0.25)
+    assert np.median(cell[c[:, 0] > 4.0]) > 3 * 0.2
+    for bad, text in (({**band, "points": [[1.0, 2.0]]}, r"mesh.refine.0.points = \[\[1.0, 2.0\]\]"),
+                      ({**band, "points": [[1.0, -2.0], [3.0, 4.0]]}, r"point \(1, -2\) a"),
+                      ({**band, "half_width": 0.0}, r"mesh.refine.0.half_width = 0.0.*valid range")):
+        with pytest.raises(SpecError, match=text):
+            make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": [bad]}})
+
+
+def test_ehlfoam_band_follows_a_written_meniscus(small_case, tmp_path):
+    """`ehlfoam band` on a write with oil inside r = 2.5 a at mid-gap: one band whose points
+    lie on r = 2.5 a within a mesh cell, from y = 0 upstream round to y = 0 downstream; its
+    TOML is a valid mesh.refine."""
+    case = _copy(small_case, tmp_path)
+    geom = load_geometry(case)
+    st = case_fields.Structure.load(case)
+    r = np.hypot(st.base_x, st.base_y)[st.base_cell] / geom.a
+    folder = case / "0.001"
+    folder.mkdir()
+    shutil.copy(case / "0.orig" / "alpha.oil", folder / "alpha.oil")
+    FoamFieldFile(folder / "alpha.oil").internal_field = (r < 2.5).astype(float)
+    out = subprocess.run(EHLFOAM + ["band", str(case), "--size", "0.1", "--half-width", "0.5"],
+                         capture_output=True, text=True, check=True)
+    refine = parse_value(out.stdout)
+    assert len(refine) == 1
+    pts = np.array(refine[0]["points"])
+    assert (refine[0]["size"], refine[0]["half_width"]) == (0.1, 0.5)
+    assert np.all(pts[:, 1] >= 0.0)
+    cell = np.sqrt(st.footprint.max()) / geom.a
+    assert np.abs(np.hypot(pts[:, 0], pts[:, 1]) - 2.5).max() < cell
+    assert np.hypot(*np.diff(pts, axis=0).T).max() < 0.5 / 4 + 1e-6   # every half_width / 4
+    assert sorted([pts[0, 0], pts[-1, 0]]) == pytest.approx([-2.5, 2.5], abs=cell)
+    spec = make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": refine}})
+    assert spec.mesh.refine[0].size_at(np.array([0.0]), np.array([2.5])) == pytest.approx(0.1)
+    bad = subprocess.run(EHLFOAM + ["band", str(case), "--size", "0.1", "--half-width", "-1"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "--half-width = -1 a is out of range" in bad.stderr
+
+
 def test_allrun_runs_by_hand(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:
