@@ -15,7 +15,11 @@ same transits. The two readings differ only in how they weigh the noise of the f
 spread is the least uncertainty of the estimate. It is an estimate, not a balance: a region that
 grows in jumps (a meniscus crossing a cell) or has a second balanced state further on is not seen.
 
-    python bench/fill_extrapolation.py CASE [CASE ...] [--fit 8] [--save NAME.json] [--note TEXT]
+    python bench/fill_extrapolation.py CASE [CASE ...] [--fit 8] [--window 1] [--table]
+        [--save NAME.json] [--note TEXT]
+
+``--window 0.5`` takes half-transit rows (``--fit`` then counts rows); ``--table`` prints them
+(with the outflow over the inflow and the rear of the region on y = 0).
 """
 from __future__ import annotations
 
@@ -37,20 +41,26 @@ from runs.report.case_data import read_history  # noqa: E402
 METRICS = ("flooded_width_over_a", "flooded_length_over_a", "inlet_meniscus_distance_over_a")
 
 
-def per_transit(history: dict[str, np.ndarray], transit_s: float) -> list[dict]:
-    """One row per whole transit of the history (``time_s`` from the run's start at 0): its
-    end time (s), the mean oil held (m3), the fill rate (-) and the metrics' means."""
+def per_transit(history: dict[str, np.ndarray], transit_s: float,
+                window: float = 1.0) -> list[dict]:
+    """One row per whole window of ``window`` transits of the history (``time_s`` from the
+    run's start at 0): its end (in transits and s), the mean oil held (m3), the fill rate (-),
+    the outflow over the inflow (where the history has it) and the metrics' means."""
     t, volume, inflow = history["time_s"], history["oil_volume_m3"], history["oil_in_m3_s"]
+    span = window * transit_s
     rows = []
-    for k in range(int(t[-1] / transit_s + 1e-9)):
-        inside = (t > k * transit_s * (1 + 1e-9)) & (t <= (k + 1) * transit_s * (1 + 1e-9))
+    for k in range(int(t[-1] / span + 1e-9)):
+        inside = (t > k * span * (1 + 1e-9)) & (t <= (k + 1) * span * (1 + 1e-9))
         if inside.sum() < 3:
             continue
         slope = np.polyfit(t[inside], volume[inside], 1)[0]
-        row = {"transit": k + 1, "t_end_s": float(t[inside][-1]),
+        row = {"transit": round((k + 1) * window, 6), "t_end_s": float(t[inside][-1]),
                "oil_volume_m3": float(volume[inside].mean()),
                "fill_rate": float(slope / inflow[inside].mean()),
                "inflow_m3_s": float(inflow[inside].mean())}
+        if "oil_out_m3_s" in history:
+            row["out_over_in"] = float(history["oil_out_m3_s"][inside].mean()
+                                       / inflow[inside].mean())
         for key in METRICS:
             v = history[key][inside]
             row[key] = float(np.nanmean(v)) if np.isfinite(v).any() else None
@@ -101,19 +111,33 @@ def extrapolate(rows: list[dict], n_fit: int) -> dict:
             "exponential_transits_to_95pc": transits_left}
 
 
-def analyse(case: str | Path, n_fit: int) -> dict:
-    """Per-transit rows and both readings of one case folder (no readings, None, before
-    three whole transits)."""
+def analyse(case: str | Path, n_fit: int, window: float = 1.0) -> dict:
+    """Rows of ``window`` transits and both readings of one case folder, fitted over the last
+    ``n_fit`` rows (no readings, None, before three whole rows)."""
     case = Path(case)
     metrics = json.loads((case / "metrics.json").read_text())
     transit = metrics.get("transit_time_s") or load_geometry(case).transit_time
     history = read_history(case / "history.csv")
-    rows = per_transit(history, transit)
+    rows = per_transit(history, transit, window)
     return {"case": case.name,
             "folder": str(case.resolve().relative_to(ROOT)) if case.resolve().is_relative_to(ROOT)
             else str(case),
             "end_reason": metrics.get("end_reason"), "per_transit": rows,
             "balance": extrapolate(rows, n_fit) if len(rows) >= 3 else None}
+
+
+def _print_rows(result: dict) -> None:
+    """The rows: where each window ends, the metrics' means, the oil and out / in; the rear
+    of the region on y = 0 is its length less the inlet meniscus distance and a."""
+    print(f"  {'transits':>9}{'width/a':>9}{'inlet/a':>9}{'rear x/a':>10}{'oil nl':>8}{'out/in':>8}")
+    for r in result["per_transit"]:
+        length, inlet = r["flooded_length_over_a"], r["inlet_meniscus_distance_over_a"]
+        rear = length - inlet - 1.0 if length is not None and inlet is not None else None
+        cells = [r["flooded_width_over_a"], inlet, rear]
+        print(f"  {r['transit']:9.2f}" + "".join(f"{v:9.2f}" if v is not None else f"{'-':>9}"
+                                                for v in cells)
+              + f" {r['oil_volume_m3'] * 1e12:8.1f}"
+              + (f"{r['out_over_in']:8.2f}" if r.get("out_over_in") is not None else ""))
 
 
 def _print(result: dict) -> None:
@@ -143,17 +167,26 @@ def _print(result: dict) -> None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("cases", nargs="+", type=Path, help="case folders with history.csv")
-    ap.add_argument("--fit", type=int, default=8, help="last transits fitted (default 8)")
+    ap.add_argument("--fit", type=int, default=8, help="last rows fitted (default 8)")
+    ap.add_argument("--window", type=float, default=1.0,
+                    help="transits per row (default 1; 0.5 for half-transit means)")
+    ap.add_argument("--table", action="store_true", help="print the rows too")
     ap.add_argument("--save", help="record name under bench/results/")
     ap.add_argument("--note", default="", help="what the record is (stored with it)")
     args = ap.parse_args(argv)
     if args.fit < 3:
         ap.error(f"--fit: {args.fit}; at least 3 transits are needed")
-    results = [analyse(c, args.fit) for c in args.cases]
+    if not 0.0 < args.window <= 100.0:
+        ap.error(f"--window: {args.window:g}; must be in (0, 100] transits")
+    results = [analyse(c, args.fit, args.window) for c in args.cases]
     for r in results:
+        if args.table:
+            print(r["folder"])
+            _print_rows(r)
         _print(r)
     if args.save:
-        save(args.save, {"note": args.note, "fit_transits": args.fit, "cases": results})
+        save(args.save, {"note": args.note, "fit_rows": args.fit, "window_transits": args.window,
+                         "cases": results})
     return 0
 
 

@@ -57,3 +57,17 @@ def test_too_few_transits_is_refused_with_the_count():
     rows = per_transit(history(tau_transits=10, transits=2), TRANSIT)
     with pytest.raises(ValueError, match="fit: 2 transits; at least 3"):
         extrapolate(rows, 8)
+
+
+def test_half_transit_rows_halve_the_window_and_keep_the_balance():
+    """--window 0.5: twice the rows, each ending half a transit after the last, the fill rate
+    of the exponential at its middle, and the same balance from the last 16 rows."""
+    h = history(tau_transits=10)
+    h["oil_out_m3_s"] = h["oil_in_m3_s"] * 0.6
+    rows = per_transit(h, TRANSIT, window=0.5)
+    assert [r["transit"] for r in rows[:3]] == [0.5, 1.0, 1.5] and len(rows) == 24
+    assert rows[-1]["fill_rate"] == pytest.approx(0.3 * np.exp(-11.75 / 10), rel=0.02)
+    assert rows[-1]["out_over_in"] == pytest.approx(0.6)
+    b = extrapolate(rows, 16)
+    assert b["fit_transits"] == [4.5, 12.0]
+    assert b["linear"]["oil_volume_m3"] == pytest.approx(V_STAR, rel=0.005)
