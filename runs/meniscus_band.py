@@ -113,12 +113,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def _check_args(args: argparse.Namespace) -> None:
     """Bad numbers fail before the case is read, naming the option and its range."""
-    checks = (("--size", args.size, 0.0, 10.0), ("--half-width", args.half_width, 0.0, 20.0),
-              ("--spacing", args.spacing, 0.0, 20.0), ("--min-length", args.min_length, -1.0, 1e3))
-    for name, value, lo, hi in checks:
-        if value is not None and not lo < value <= hi:
-            raise ValueError(f"{name} = {value:g} a is out of range ({max(lo, 0.0):g} < {name} "
-                             f"<= {hi:g} a)")
+    for name, value, hi in (("--size", args.size, 10.0), ("--half-width", args.half_width, 20.0),
+                            ("--spacing", args.spacing, 20.0)):
+        if value is not None and not 0.0 < value <= hi:
+            raise ValueError(f"{name} = {value:g} a is out of range (0 < {name} <= {hi:g} a)")
+    if args.min_length is not None and not 0.0 <= args.min_length <= 1e3:
+        raise ValueError(f"--min-length = {args.min_length:g} a is out of range "
+                         "(0 <= --min-length <= 1000 a)")
 
 
 def cmd_band(args: argparse.Namespace) -> int:
