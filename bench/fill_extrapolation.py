@@ -133,9 +133,9 @@ def _print_rows(result: dict) -> None:
     for r in result["per_transit"]:
         length, inlet = r["flooded_length_over_a"], r["inlet_meniscus_distance_over_a"]
         rear = length - inlet - 1.0 if length is not None and inlet is not None else None
-        cells = [r["flooded_width_over_a"], inlet, rear]
+        values = [r["flooded_width_over_a"], inlet, rear]
         print(f"  {r['transit']:9.2f}" + "".join(f"{v:9.2f}" if v is not None else f"{'-':>9}"
-                                                for v in cells)
+                                                for v in values)
               + f" {r['oil_volume_m3'] * 1e12:8.1f}"
               + (f"{r['out_over_in']:8.2f}" if r.get("out_over_in") is not None else ""))
 

@@ -305,8 +305,11 @@ def _refine_kind(value: Any) -> str:
     return "band" if isinstance(value, RefineBand) else "box"
 
 
+#: the kinds of ``mesh.refine`` entries, by the tag pydantic puts in an error's location
+REFINE_KINDS: dict[str, type[BaseModel]] = {"box": RefineBox, "band": RefineBand}
+
 #: an entry of ``mesh.refine``: a box, or a band along a line
-Refinement = Annotated[Union[Annotated[RefineBox, Tag("box")], Annotated[RefineBand, Tag("band")]],
+Refinement = Annotated[Union[tuple(Annotated[m, Tag(t)] for t, m in REFINE_KINDS.items())],
                        Discriminator(_refine_kind)]
 
 
@@ -562,10 +565,6 @@ def _drop_none(value):
 
 
 # ------------------------------------------------------------------ errors
-#: the tags pydantic puts in an error's location inside a tagged union (``mesh.refine``)
-_UNION_TAGS = {"box": RefineBox, "band": RefineBand}
-
-
 def _models_in(annotation: Any) -> list[type[BaseModel]]:
     """The model classes an annotation holds (itself, or inside a tuple, union, Annotated)."""
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
@@ -577,7 +576,7 @@ def _spec_loc(loc: tuple) -> tuple:
     """An error location as the spec names it: without the tag of a union member
     (``mesh.refine.0.band.size`` -> ``mesh.refine.0.size``)."""
     return tuple(p for i, p in enumerate(loc)
-                 if not (p in _UNION_TAGS and i > 0 and isinstance(loc[i - 1], int)))
+                 if not (p in REFINE_KINDS and i > 0 and isinstance(loc[i - 1], int)))
 
 
 def _field_at(model: type[BaseModel], loc: tuple) -> tuple[type[BaseModel] | None, Any]:
@@ -587,8 +586,8 @@ def _field_at(model: type[BaseModel], loc: tuple) -> tuple[type[BaseModel] | Non
     for part in loc:
         if isinstance(part, int):
             continue
-        if part in _UNION_TAGS and field is not None:
-            model, field = _UNION_TAGS[part], None
+        if part in REFINE_KINDS and field is not None:
+            model, field = REFINE_KINDS[part], None
             continue
         if field is not None:
             inner = _models_in(field.annotation)

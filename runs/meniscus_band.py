@@ -131,8 +131,9 @@ def cmd_band(args: argparse.Namespace) -> int:
         return 2
     bands = meniscus_bands(lines, args.size, args.half_width, args.spacing, args.min_length)
     if not bands:
-        print(f"ehlfoam band: {args.case} has no meniscus line of "
-              f"{args.min_length or args.half_width:g} a or longer at t = {time:g} s",
+        shortest = args.half_width if args.min_length is None else args.min_length
+        print(f"ehlfoam band: {args.case} has no meniscus line of {shortest:g} a or longer "
+              f"at t = {time:g} s",
               file=sys.stderr)
         return 1
     print(bands_toml(bands))
