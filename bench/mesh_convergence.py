@@ -5,7 +5,11 @@ cell size that sets each mesh apart (``--sizes``), the observed order, the Richa
 grid convergence index of every metric over each three meshes in a row.
 
     python bench/mesh_convergence.py CASE_COARSE CASE_MEDIUM CASE_FINE [--transits 1 2]
-        [--final] [--sizes H_COARSE H_MEDIUM H_FINE] [--save NAME.json] [--note TEXT]
+        [--window W] [--final] [--sizes H_COARSE H_MEDIUM H_FINE] [--save NAME.json]
+        [--note TEXT]
+
+At equal times each case gives its write nearest the time, or with ``--window W`` its mean over
+the writes of the W transits up to it (a resolved meniscus jitters write by write).
 
 The reading is ``runs.convergence.observed_order`` (Celik et al. 2008; its docstring has the
 formulas). Writes ``bench/results/NAME.json`` (default mesh_convergence.json).
@@ -14,7 +18,6 @@ formulas). Writes ``bench/results/NAME.json`` (default mesh_convergence.json).
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 from pathlib import Path
@@ -24,21 +27,27 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
-from runs.convergence import METRICS, jitter, last_transit, observed_order  # noqa: E402
+from runs.convergence import (METRICS, jitter, last_transit, observed_order,  # noqa: E402
+                              read_history_rows, window_mean)
 
 KEYS = METRICS
 
 
-def at_time(case: Path, t: float) -> dict | None:
+def at_time(case: Path, t: float, window: float | None = None) -> dict | None:
     """The case's write nearest ``t`` [s] (None if none lies within 2 %), with each metric's
-    jitter over the writes of the quarter transit up to it."""
-    rows = list(csv.DictReader(open(case / "history.csv")))
+    jitter over the writes of the quarter transit up to it; with ``window`` [transits], each
+    metric's mean over the writes of the ``window`` transits up to that write instead."""
+    rows = read_history_rows(case)
+    if not rows:
+        return None
     best = min(rows, key=lambda r: abs(float(r["time_s"]) - t))
     tb = float(best["time_s"])
     if abs(tb - t) > 0.02 * t:
         return None
-    window = 0.25 * load_geometry(case).transit_time
-    recent = [r for r in rows if tb - window <= float(r["time_s"]) <= tb]
+    if window is not None:
+        return window_mean(case, tb, window)
+    span = 0.25 * load_geometry(case).transit_time
+    recent = [r for r in rows if tb - span <= float(r["time_s"]) <= tb]
     return {k: (float(best[k]) if best[k] not in ("", "None") else None) for k in KEYS} | {
         "time_s": tb, "state": best["state"], "jitter": jitter(recent)}
 
@@ -46,7 +55,8 @@ def at_time(case: Path, t: float) -> dict | None:
 def orders(names: list[str], sizes: list[float], levels: dict) -> dict:
     """observed_order of every metric over each three cases in a row (ordered as given); the
     noise is twice the largest jitter of the three (over the last transit with ``--final``,
-    over the quarter transit up to the write compared otherwise)."""
+    over the window with ``--window``, over the quarter transit up to the write compared
+    otherwise)."""
     out = {}
     for i in range(len(names) - 2):
         trio = names[i:i + 3]
@@ -86,6 +96,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("cases", nargs="+")
     ap.add_argument("--transits", nargs="+", type=float, default=[1.0, 2.0])
+    ap.add_argument("--window", type=float, default=None, metavar="W",
+                    help="at equal times, each metric's mean over the W transits up to the "
+                         "time, not the one write")
     ap.add_argument("--final", action="store_true",
                     help="compare each case's last transit (mean), not equal times")
     ap.add_argument("--sizes", nargs="+", type=float,
@@ -107,7 +120,7 @@ def main(argv=None) -> int:
     for label, t in samples:
         levels = {}
         for name, case in zip(names, cases):
-            vals = last_transit(case) if t is None else (at_time(case, t) or {})
+            vals = last_transit(case) if t is None else (at_time(case, t, args.window) or {})
             levels[name] = {"cells": load_geometry(case).cells} | vals
         row = {"sample": label, "time_s": t, "levels": levels}
         print(label if t is None else f"t = {t:.4f} s ({label})")

@@ -106,21 +106,31 @@ def read_history_rows(case: Path) -> list[dict]:
         return list(csv.DictReader(fh))
 
 
-def last_transit(case: Path) -> dict | None:
-    """The case's last state: each metric's mean over the last transit of its history.csv
-    (one write alone carries the meniscus's cell-to-cell jitter), that jitter, the time [s]
-    and the state of the last write; None without a history."""
+def window_mean(case: Path, t_end: float | None = None, span: float = 1.0) -> dict | None:
+    """Each metric's mean over the writes of history.csv within ``span`` transits up to
+    ``t_end`` [s] (default: the last write; one write alone carries the meniscus's
+    cell-to-cell jitter and, on a resolved inlet, the drops that merge into it), that jitter,
+    the time [s] and state of the window's last write and the writes averaged; None without a
+    history or without a write in the window."""
     rows = read_history_rows(case)
+    if t_end is not None:
+        rows = [r for r in rows if float(r["time_s"]) <= t_end * (1 + 1e-9)]
     if not rows:
         return None
-    t_end = float(rows[-1]["time_s"])
-    last = [r for r in rows if float(r["time_s"]) >= t_end - load_geometry(case).transit_time]
+    t_last = float(rows[-1]["time_s"])
+    last = [r for r in rows
+            if float(r["time_s"]) >= t_last - span * load_geometry(case).transit_time]
     means = {}
     for k in METRICS:
         vals = [float(r[k]) for r in last if r.get(k) not in (None, "", "None")]
         means[k] = sum(vals) / len(vals) if vals else None
-    return means | {"time_s": t_end, "state": rows[-1]["state"], "writes_averaged": len(last),
+    return means | {"time_s": t_last, "state": rows[-1]["state"], "writes_averaged": len(last),
                     "jitter": jitter(last)}
+
+
+def last_transit(case: Path) -> dict | None:
+    """The case's last state: :func:`window_mean` over the last transit of its history."""
+    return window_mean(case)
 
 
 def level_size(case: Path) -> float:

@@ -1,11 +1,21 @@
 """runs/convergence.py: the observed order and grid convergence index (Celik et al. 2008) on
-metrics with a known limit: f(h) = f0 + C h^p."""
+metrics with a known limit: f(h) = f0 + C h^p; and the means over a window of writes that
+bench/mesh_convergence.py compares."""
 
 from __future__ import annotations
 
+import csv
+import json
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
 import pytest
 
-from runs.convergence import observed_order
+from bench.mesh_convergence import at_time
+from generator.case_writer import META
+from runs.convergence import METRICS, last_transit, observed_order, window_mean
+from tiny import tiny_geometry
 
 
 @pytest.mark.parametrize("sizes", [(0.2, 0.1, 0.05), (0.8, 0.55, 0.38), (0.05, 0.2, 0.1)])
@@ -62,3 +72,35 @@ def test_an_order_far_from_the_schemes_is_flagged_not_asymptotic():
     assert o["order"] == pytest.approx(0.155, abs=0.005)
     assert o["asymptotic"] is False
     assert observed_order((0.2, 0.1, 0.05), (14.4, 14.1, 14.025))["asymptotic"] is True
+
+
+def _case_with_history(folder: Path, times: np.ndarray, inlet: np.ndarray) -> Path:
+    """A case folder with a made-up geometry (transit 0.1 s) and a history.csv whose inlet
+    meniscus is ``inlet`` and whose width grows by 1 a a second."""
+    (folder / META).mkdir(parents=True)
+    (folder / META / "geometry.json").write_text(json.dumps(asdict(tiny_geometry())))
+    with open(folder / "history.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["time_s", "state", *METRICS])
+        for t, x in zip(times, inlet):
+            w.writerow([t, "I", x, 12.0 + t, 18.0, 1.5e-10])
+    return folder
+
+
+def test_a_window_averages_out_a_meniscus_that_jumps_write_by_write(tmp_path):
+    # writes every 0.01 s (a tenth of a transit); the inlet jumps 4.5 / 5.5 a write by write
+    times = np.round(np.arange(1, 61) * 0.01, 6)
+    case = _case_with_history(tmp_path / "c", times, np.where(np.arange(60) % 2, 5.5, 4.5))
+    one = at_time(case, 0.3)
+    assert one["inlet_meniscus_distance_over_a"] in (4.5, 5.5)
+    mean = at_time(case, 0.3, window=0.5)         # the writes at 0.25-0.30 s
+    assert mean["writes_averaged"] == 6
+    assert mean["inlet_meniscus_distance_over_a"] == pytest.approx(5.0)
+    assert mean["flooded_width_over_a"] == pytest.approx(12.275)
+    assert mean["jitter"]["inlet_meniscus_distance_over_a"] == pytest.approx(0.5)
+    assert mean["time_s"] == pytest.approx(0.3)
+    assert at_time(case, 0.9, window=0.5) is None     # the run never got there
+    last = last_transit(case)                         # the writes at 0.5-0.6 s
+    assert last["writes_averaged"] == 11 and last["time_s"] == pytest.approx(0.6)
+    assert last == window_mean(case, None, 1.0)
+    assert last["flooded_width_over_a"] == pytest.approx(12.55)

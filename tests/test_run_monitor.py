@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from generator.case_spec import load_case_spec
-from generator.case_writer import CaseGeometry
 from runs.case_fields import Sample, gas_dissolution, gas_release, smeared_oil_fraction
 from runs.run_case import (CLEARANCE_WARNING, OFF_OUTLET_WARNING, REAR_CELL_WARNING,
                            boundary_warnings, dissolved_air_budget, mass_balance,
                            rear_cell_warnings, rear_meniscus_cell, steady_test)
+from tiny import tiny_geometry as _geometry
 
 
 def history(volumes, menisci, dt=0.01, state="I"):
@@ -98,16 +98,6 @@ def test_mass_balance_closes_for_a_consistent_history():
     assert mb["oil_mass_balance_error"] == pytest.approx(0.0, abs=1e-12)
     h[-1].oil_volume += 0.06     # 10 % of the oil carried in, lost or gained
     assert mass_balance(h)["oil_mass_balance_error"] == pytest.approx(0.1)
-
-
-def _geometry(**kw) -> CaseGeometry:
-    base = dict(a=1e-4, radius=0.01, speed=0.01, x_min=-1e-3, x_max=1e-3, y_max=1e-3,
-                island_radius=1.5e-4, symmetric=True, n_layers=4, cells=3, transit_time=0.1,
-                end_time=0.1, write_interval=0.01, max_delta_t=1e-4, capillary_limit="none",
-                min_cell_size=1e-5, island_gap=1e-6, hc=1e-8, contact_flow=0.0,
-                gap_mismatch=0.0, oil_viscosity=0.02, oil_density=870.0,
-                solver="interPhaseChangeFoam")
-    return CaseGeometry(**(base | kw))
 
 
 def test_gas_release_sums_kunz_vaporisation_below_the_release_pressure():

@@ -1,6 +1,9 @@
 """The tiny case the OpenFOAM tests share: coarse mesh, 3 cells across the gap, a cheap
 precalc (the gap outside the island hardly depends on the film's last digits), 1 ms of flow
-from a puddle of 3 a around the contact. Builds in seconds, runs in seconds."""
+from a puddle of 3 a around the contact. Builds in seconds, runs in seconds. And the numbers
+of a made-up case (:func:`tiny_geometry`) for code that only reads a case's geometry."""
+
+from generator.case_writer import CaseGeometry
 
 SMALL = {
     "name": "test",
@@ -12,3 +15,15 @@ SMALL = {
                "track_half_width": 2.5e-4, "initial_puddle": 3.0},
     "run": {"end_time": 1e-3, "writes_per_transit": 1000},
 }
+
+
+def tiny_geometry(**kw) -> CaseGeometry:
+    """A :class:`CaseGeometry` of a made-up case (a = 0.1 mm, transit 0.1 s, 3 cells),
+    ``kw`` overriding any field."""
+    base = dict(a=1e-4, radius=0.01, speed=0.01, x_min=-1e-3, x_max=1e-3, y_max=1e-3,
+                island_radius=1.5e-4, symmetric=True, n_layers=4, cells=3, transit_time=0.1,
+                end_time=0.1, write_interval=0.01, max_delta_t=1e-4, capillary_limit="none",
+                min_cell_size=1e-5, island_gap=1e-6, hc=1e-8, contact_flow=0.0,
+                gap_mismatch=0.0, oil_viscosity=0.02, oil_density=870.0,
+                solver="interPhaseChangeFoam")
+    return CaseGeometry(**(base | kw))
