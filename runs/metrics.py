@@ -359,12 +359,13 @@ def _upstream_meniscus(r: Raster, row: int, region: np.ndarray, threshold: float
     return _crossing(r.x[k], alpha[k], r.x[k + 1], alpha[k + 1], threshold), False
 
 
-def _meniscus_shape(r: Raster, flooded: np.ndarray, threshold: float) -> tuple[str | None, float | None]:
-    """("convex" | "concave" | None, c2) from a fit x_m/a = c0 + c2 (y/a)^2 over |y| <= R."""
+def _meniscus_shape(r: Raster, region: np.ndarray, threshold: float) -> tuple[str | None, float | None]:
+    """("convex" | "concave" | None, c2) from a fit x_m/a = c0 + c2 (y/a)^2 over |y| <= R, the
+    meniscus on each row bounding ``region``."""
     a = r.geom.a
     ys, xm, any_free = [], [], False
     for row in np.flatnonzero(np.abs(r.y) <= r.geom.island_radius):
-        pos, at_rim = _upstream_meniscus(r, int(row), flooded, threshold)
+        pos, at_rim = _upstream_meniscus(r, int(row), region, threshold)
         if pos is None:
             continue
         ys.append(float(r.y[row]) / a)
@@ -461,9 +462,12 @@ def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any
     wake_open = bool((outer_rim & (xx > 0.0)).any())
     state = "II" if outer_rim.any() else "I"
 
-    inlet_x, inlet_at_rim = _upstream_meniscus(r, r.axis_row, oil, threshold)
+    # the meniscus bounds the outer air: the walk upstream passes over the air bubbles that
+    # the oil encloses (carried in by the supply drops that merge into the inlet)
+    held = ~outer & ~r.island
+    inlet_x, inlet_at_rim = _upstream_meniscus(r, r.axis_row, held, threshold)
     inlet = None if inlet_x is None else max(0.0, float((-a - inlet_x) / a))
-    shape, c2 = _meniscus_shape(r, flooded, threshold)
+    shape, c2 = _meniscus_shape(r, held, threshold)
 
     length = width = x_lo = x_hi = clearance = nearest = None
     if flooded.any():
@@ -519,17 +523,19 @@ def flow_pattern(x: Any, y: Any, alpha: Any, geom: Geometry, threshold: float = 
     ``state``
         "I" (no outer air touches the island rim) or "II" (it does).
     ``inlet_meniscus_distance_over_a``
-        on ``y = 0``, from ``x = -a`` upstream to the first oil->gas crossing
-        of ``alpha = threshold`` upstream of the island rim (>= 0). When gas
-        touches the rim on the inlet side the meniscus is at or inside the
-        rim: ``(island_radius - a)/a`` (and ``inlet_meniscus_at_rim``).
-        None when oil reaches the inlet edge ``x_min``.
+        on ``y = 0``, from ``x = -a`` upstream to the first crossing of
+        ``alpha = threshold`` into the outer air (gas connected to the domain
+        edge) upstream of the island rim (>= 0): air bubbles the oil encloses
+        are passed over. When outer air touches the rim on the inlet side the
+        meniscus is at or inside the rim: ``(island_radius - a)/a`` (and
+        ``inlet_meniscus_at_rim``). None when oil reaches the inlet edge
+        ``x_min``.
     ``inlet_meniscus_at_rim``
         the axis meniscus is at (or hidden inside) the island rim.
     ``inlet_meniscus_shape``, ``inlet_meniscus_c2``
-        fit ``x_m/a = c0 + c2 (y/a)^2`` of the upstream meniscus of the
-        flooded region over the rows ``|y| <= island_radius`` (rows where gas
-        touches the rim count at the rim): "convex" (``c2 > 0``, bulging
+        fit ``x_m/a = c0 + c2 (y/a)^2`` of the upstream meniscus (as above)
+        over the rows ``|y| <= island_radius`` (rows where outer air touches
+        the rim count at the rim): "convex" (``c2 > 0``, bulging
         upstream) or "concave" (``c2 < 0``, the butterfly of a starved
         inlet); None when undefined (no meniscus off the rim, oil to the
         inlet, or flat within a tenth of a pixel).

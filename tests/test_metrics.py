@@ -171,6 +171,21 @@ def test_detached_bubble_not_wake_gas():
     assert m["wake_gas_length_over_a"] == 0.0
 
 
+def test_air_bubbles_ahead_of_the_contact_are_not_the_inlet_meniscus():
+    # bubbles the oil carries toward the contact: one on the axis 1.5 a ahead of the island
+    # and one against its inlet rim; the meniscus that bounds the outer air stays at 4 a
+    def field(x, y):
+        return np.maximum.reduce([bulging(x, y), -box(x, y, -3.3 * A, -2.7 * A, 0.3 * A),
+                                  -box(x, y, -1.8 * A, -1.2 * A, 0.3 * A)])
+
+    m = pattern(field)
+    assert m["state"] == "I" and m["enclosed_bubbles"] == 2
+    assert m["inlet_meniscus_at_rim"] is False
+    assert m["inlet_meniscus_distance_over_a"] == pytest.approx(3.0, abs=TOL)
+    assert m["inlet_meniscus_shape"] == "convex"
+    assert m["inlet_meniscus_c2"] == pytest.approx(pattern(bulging)["inlet_meniscus_c2"])
+
+
 def test_off_axis_bubble_counts_twice_in_full_picture():
     def field(x, y):
         return np.maximum(ring(x, y, 5 * A), -box(x, y - 3 * A, -1 * A, 1 * A, 0.5 * A))
