@@ -38,14 +38,7 @@ def rank_times(case: Path) -> list[str]:
     """The time folders the ranks wrote (processor0), as named, in time order (the case's
     own time folders where it ran on one rank)."""
     where = case / "processor0" if (case / "processor0").is_dir() else case
-    names = []
-    for p in where.iterdir():
-        try:
-            if p.is_dir() and float(p.name) > 0.0:
-                names.append(p.name)
-        except ValueError:
-            continue
-    return sorted(names, key=float)
+    return [folder.name for _, folder in case_fields.time_folders(where)]
 
 
 def measure(case: Path, name: str, structure: case_fields.Structure, geom,
