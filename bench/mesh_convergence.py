@@ -27,8 +27,8 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
-from runs.convergence import (METRICS, jitter, last_transit, observed_order,  # noqa: E402
-                              read_history_rows, window_mean)
+from runs.convergence import (METRICS, history_number, jitter, last_transit,  # noqa: E402
+                              observed_order, read_history_rows, window_mean)
 
 KEYS = METRICS
 
@@ -48,7 +48,7 @@ def at_time(case: Path, t: float, window: float | None = None) -> dict | None:
         return window_mean(case, tb, window)
     span = 0.25 * load_geometry(case).transit_time
     recent = [r for r in rows if tb - span <= float(r["time_s"]) <= tb]
-    return {k: (float(best[k]) if best[k] not in ("", "None") else None) for k in KEYS} | {
+    return {k: history_number(best[k]) for k in KEYS} | {
         "time_s": tb, "state": best["state"], "jitter": jitter(recent)}
 
 

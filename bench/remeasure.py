@@ -27,7 +27,7 @@ sys.path.insert(0, str(ROOT))
 from bench.common import save  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
 from runs import case_fields, metrics  # noqa: E402
-from runs.convergence import read_history_rows  # noqa: E402
+from runs.convergence import history_number, read_history_rows  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
 
 KEYS = ("inlet_meniscus_distance_over_a", "inlet_meniscus_shape", "flooded_width_over_a",
@@ -59,10 +59,6 @@ def measure(case: Path, name: str, structure: case_fields.Structure, geom,
     r = metrics.raster(structure.base_x, structure.base_y, mid,
                        case_fields.pattern_geometry(geom))
     return metrics.flow_pattern_from_raster(r)
-
-
-def _number(value) -> float | None:
-    return None if value in (None, "", "None") else float(value)
 
 
 def window_means(rows: list[dict], span: float) -> list[dict]:
@@ -107,11 +103,11 @@ def main(argv=None) -> int:
         now = measure(case, name, structure, geom, runtime)
         old = recorded.get(round(float(name), 9), {})
         row = {"time_s": float(name), "transits": float(name) / geom.transit_time,
-               "recorded_inlet": _number(old.get("inlet_meniscus_distance_over_a")),
+               "recorded_inlet": history_number(old.get("inlet_meniscus_distance_over_a")),
                "inlet": now["inlet_meniscus_distance_over_a"],
                "recorded_shape": old.get("inlet_meniscus_shape") or None,
                "shape": now["inlet_meniscus_shape"],
-               "recorded_width": _number(old.get("flooded_width_over_a")),
+               "recorded_width": history_number(old.get("flooded_width_over_a")),
                "width": now["flooded_width_over_a"],
                "enclosed_bubbles": now["enclosed_bubbles"]}
         rows.append(row)

@@ -87,12 +87,17 @@ def observed_order(h: tuple[float, float, float], f: tuple[float, float, float],
                   "error_fine": abs((f1 - ext) / ext) if ext else None}
 
 
+def history_number(value: str | None) -> float | None:
+    """A history.csv cell as a number, None where the metric was undefined ("", "None")."""
+    return None if value in (None, "", "None") else float(value)
+
+
 def jitter(rows: list[dict]) -> dict[str, float]:
     """Per metric, the standard deviation over history.csv ``rows`` (0 for fewer than two
     values)."""
     out = {}
     for k in METRICS:
-        vals = np.array([float(r[k]) for r in rows if r.get(k) not in (None, "", "None")])
+        vals = np.array([v for r in rows if (v := history_number(r.get(k))) is not None])
         out[k] = float(vals.std()) if vals.size > 1 else 0.0
     return out
 
@@ -122,7 +127,7 @@ def window_mean(case: Path, t_end: float | None = None, span: float = 1.0) -> di
             if float(r["time_s"]) >= t_last - span * load_geometry(case).transit_time]
     means = {}
     for k in METRICS:
-        vals = [float(r[k]) for r in last if r.get(k) not in (None, "", "None")]
+        vals = [v for r in last if (v := history_number(r.get(k))) is not None]
         means[k] = sum(vals) / len(vals) if vals else None
     return means | {"time_s": t_last, "state": rows[-1]["state"], "writes_averaged": len(last),
                     "jitter": jitter(last)}
