@@ -984,3 +984,47 @@ def test_oil_change_splits_a_known_change_by_class_and_position(small_case, tmp_
     profile = res["outside_by_distance"]
     assert sum(b["total_nl"] for b in profile) == pytest.approx(nl(film), rel=1e-9)
     assert [b["total_nl"] for b in profile[:2]] == [0.0, 0.0]
+
+
+def test_region_fill_is_the_oil_ahead_of_a_plane_over_the_supply(small_case, tmp_path):
+    """bench/region_fill.py on three writes by hand: oil wall to wall ahead of x = 1, 2, 2 a,
+    and from the second write a film (the disc's layer of cells) beyond x = 4 a. Ahead of a
+    plane at 3 a the fill is the region's growth over what the history says came in, then 0;
+    ahead of a plane at 5 a it also counts the film's part ahead of it."""
+    from bench.region_fill import region_fill
+
+    case = _copy(small_case, tmp_path)
+    geom = load_geometry(case)
+    st = case_fields.Structure.load(case)
+    x = st.base_x[st.base_cell] / geom.a
+    film = (x > 4.0) & (st.layer == 0)
+    writes = {1e-3: x < 1.0, 2e-3: (x < 2.0) | film, 4e-3: (x < 2.0) | film}
+    q_in = 2e-12                                              # m3/s
+    rows = ["time_s,oil_in_m3_s"]
+    for t, oil in writes.items():
+        folder = case / f"{t:g}"
+        folder.mkdir()
+        shutil.copy(case / "0.orig" / "alpha.oil", folder / "alpha.oil")
+        FoamFieldFile(folder / "alpha.oil").internal_field = oil.astype(float)
+        rows.append(f"{t!r},{q_in!r}")
+    (case / "history.csv").write_text("\n".join(rows) + "\n")
+    unlisted = case / "0.003"                 # a write the history does not list: not read
+    shutil.copytree(case / "0.001", unlisted)
+    FoamFieldFile(unlisted / "alpha.oil").internal_field = np.ones(len(x))
+
+    res = region_fill(case, [3.0, 5.0])
+    assert res["times_s"] == pytest.approx([1e-3, 2e-3, 4e-3])
+    vol = lambda sel: geom.mirror * st.cell_volumes[sel].sum()  # noqa: E731
+    grown = vol((x >= 1.0) & (x < 2.0))
+    assert res["oil_ahead_m3"][0] == pytest.approx([vol(x < 1.0)] * 2, rel=1e-9)
+    fill_3, fill_5 = np.array(res["fill_per_interval"]).T
+    assert fill_3 == pytest.approx([grown / (q_in * 1e-3), 0.0], rel=1e-9, abs=1e-12)
+    in_film = vol(film & (x < 5.0))
+    assert in_film > 0.0
+    assert fill_5 == pytest.approx([(grown + in_film) / (q_in * 1e-3), 0.0], rel=1e-9,
+                                   abs=1e-12)
+    assert res["fill"] == pytest.approx([grown / (q_in * 3e-3),
+                                         (grown + in_film) / (q_in * 3e-3)], rel=1e-9)
+    # one write alone gives no fill
+    with pytest.raises(ValueError, match="needs two"):
+        region_fill(case, [3.0], from_transits=3e-3 / geom.transit_time)

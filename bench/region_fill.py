@@ -1,0 +1,121 @@
+"""How fast the flooded region fills, measured where its oil leaves it: the oil held ahead of
+planes x = X behind the contact, write by write.
+
+A run's outflow through its outlet lags the region by the time the walls take to carry the
+films there (the outlet 7 a behind the rear meniscus is 0.2 transits), and right after a run
+starts from another mesh's fields most of it is film laid down before the start. The oil
+ahead of a plane just behind the rear meniscus, V(X) = sum(alpha V) over the cells whose
+column centre lies at x < X (whole contact, doubled in a half domain), changes only by what
+the supply brings in and what crosses the plane (nothing leaves through the side or the
+upstream boundary ahead of it; the run's history.csv says so). So between two writes
+
+    fill(X) = (V(X, t2) - V(X, t1)) / (in (t2 - t1))
+
+is the share of the supply the region and its surroundings ahead of X kept over that
+interval: exact by conservation, with no flux to interpolate. Where fill(X) is 0 the region
+is at its balance; its change with the oil held says how far off that is.
+
+    python bench/region_fill.py CASE [CASE ...] [--planes 14 16] [--from T] [--save NAME.json]
+
+Prints, per case and write, the oil ahead of each plane and the fill over the interval up to
+that write, and the fill over all the writes from T transits on (first to last write).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from bench.common import save  # noqa: E402
+from generator.case_writer import load_geometry  # noqa: E402
+from runs import case_fields  # noqa: E402
+from runs.convergence import history_number, read_history_rows  # noqa: E402
+
+NL = 1e-12  # m3 per nanolitre
+
+
+def oil_ahead(alpha: np.ndarray, structure: case_fields.Structure, a: float, mirror: float,
+              planes_over_a: list[float]) -> list[float]:
+    """The oil [m3, whole contact] in the cells whose column centre lies at x < X, for each
+    plane X [a], of the oil fractions ``alpha`` per cell."""
+    x = structure.base_x[structure.base_cell] / a
+    oil = np.clip(alpha, 0.0, 1.0) * structure.cell_volumes
+    return [mirror * float(oil[x < X].sum()) for X in planes_over_a]
+
+
+def fills(times: np.ndarray, ahead: np.ndarray, inflow: np.ndarray) -> np.ndarray:
+    """Per interval between consecutive writes (times [s], oil ahead [m3] shape (writes,
+    planes), supply inflow [m3/s] per write): the change of the oil ahead over what the
+    supply brought in, shape (writes - 1, planes)."""
+    dt = np.diff(times)[:, None]
+    q_in = 0.5 * (inflow[1:] + inflow[:-1])[:, None]
+    return np.diff(ahead, axis=0) / (q_in * dt)
+
+
+def region_fill(case: str | Path, planes_over_a: list[float],
+                from_transits: float = 0.0) -> dict:
+    """The oil ahead of each plane at each write of ``case`` from ``from_transits`` on, the
+    fill over each interval and over them all (module docstring)."""
+    case = Path(case)
+    geom, structure = load_geometry(case), case_fields.Structure.load(case)
+    inflow = {round(history_number(r["time_s"]), 9): history_number(r["oil_in_m3_s"])
+              for r in read_history_rows(case)}
+    times, ahead, q_in = [], [], []
+    for t, folder in case_fields.time_folders(case):
+        q = inflow.get(round(t, 9))
+        if t < from_transits * geom.transit_time - 1e-12 or q is None:
+            continue
+        alpha = case_fields.read_alpha(folder / "alpha.oil", structure)
+        times.append(t)
+        ahead.append(oil_ahead(alpha, structure, geom.a, geom.mirror, planes_over_a))
+        q_in.append(q)
+    if len(times) < 2:
+        raise ValueError(f"{case} has {len(times)} write(s) in its history from "
+                         f"{from_transits} transits on; the fill needs two")
+    times, ahead, q_in = np.array(times), np.array(ahead), np.array(q_in)
+    per = fills(times, ahead, q_in)
+    overall = fills(times[[0, -1]], ahead[[0, -1]], np.full(2, q_in.mean()))[0]
+    return {"case": str(case), "planes_over_a": planes_over_a, "from_transits": from_transits,
+            "transit_s": geom.transit_time, "times_s": times.tolist(),
+            "oil_in_m3_s": q_in.tolist(), "oil_ahead_m3": ahead.tolist(),
+            "fill_per_interval": per.tolist(), "fill": overall.tolist(),
+            "fill_sd": per.std(axis=0).tolist()}
+
+
+def _print(result: dict) -> None:
+    planes = result["planes_over_a"]
+    print(f"\n{result['case']}")
+    print("transits  " + "  ".join(f"oil<{X:g}a nl   fill" for X in planes))
+    ahead, per = result["oil_ahead_m3"], result["fill_per_interval"]
+    for i, t in enumerate(result["times_s"]):
+        cells = "  ".join(
+            f"{ahead[i][k] / NL:10.2f}  " + (f"{per[i - 1][k]:5.2f}" if i else "    -")
+            for k in range(len(planes)))
+        print(f"{t / result['transit_s']:8.3f}  {cells}")
+    print("overall   " + "  ".join(f"{'':10s}  {f:5.2f}" for f in result["fill"]))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("cases", nargs="+", type=Path)
+    ap.add_argument("--planes", nargs="+", type=float, default=[14.0, 16.0],
+                    help="x of the planes [a] (default 14 16)")
+    ap.add_argument("--from", dest="start", type=float, default=0.0,
+                    help="first write read [transits] (default 0)")
+    ap.add_argument("--save", help="write bench/results/NAME.json")
+    args = ap.parse_args(argv)
+    results = [region_fill(c, args.planes, args.start) for c in args.cases]
+    for r in results:
+        _print(r)
+    if args.save:
+        save(args.save, {"command": " ".join(sys.argv), "results": results})
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
