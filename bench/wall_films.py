@@ -16,6 +16,16 @@ outlet); with the outlet at 20 a and the rear at 13.7 a the median column sits w
 is some 1.5 times the meniscus's (docs/cases.md, "What the films converge to").
 
     python bench/wall_films.py CASE [CASE ...] [--save NAME.json]
+
+With ``--rear``, the films as the rear meniscus lays them, write by write: the rear meniscus
+x_r (the furthest mid-gap oil, alpha > 0.5, on |y| < 0.15 a), the gap h_r there, and the oil per
+column over h_r, against LL (medians over the columns with air at mid-gap on |y| < 1 a and
+x_r + d0 < x < x_r + d1, for each ``--bins`` pair d0 d1 in a; default 1-2 a, past the wedges of
+oil the meniscus leaves along both walls, some h_r / 2 beyond its apex). The walls carry a film
+laid at t0 to x_r + u (t - t0): a run that starts from other fields shows its own films in a
+bin d1 only after d1 / 10 transits (a transit is 10 a).
+
+    python bench/wall_films.py CASE [CASE ...] --rear [--bins 1 2] [--from T] [--save NAME.json]
 """
 from __future__ import annotations
 
@@ -65,11 +75,77 @@ def films(case: Path) -> dict:
     return out
 
 
+#: the half-width [a] of the strip along y = 0 the rear meniscus is found on
+AXIS_HALF_WIDTH = 0.15
+
+
+def rear_films(case: Path, bins: list[tuple[float, float]] = ((1.0, 2.0),),
+               from_transits: float = 0.0) -> dict:
+    """Per write of ``case`` from ``from_transits`` on: the rear meniscus on the axis x_r [a],
+    the gap there [m] and, per bin (d0, d1) [a] behind it, the median oil per column over
+    that gap, over Landau-Levich's both films together (module docstring)."""
+    geom, spec = load_geometry(case), load_spec_of(case)
+    st = case_fields.Structure.load(case)
+    n = len(st.base_x)
+    gap = np.bincount(st.base_cell, st.cell_volumes, minlength=n) / st.footprint
+    x, y = st.base_x / geom.a, np.abs(st.base_y) / geom.a
+    axis = y < AXIS_HALF_WIDTH
+    ll = landau_levich(spec.oil_viscosity, spec.speed, spec.physics.surface_tension)
+    writes = []
+    for t, folder in case_fields.time_folders(case):
+        if t < from_transits * geom.transit_time - 1e-12:
+            continue
+        alpha = np.clip(case_fields.read_alpha(folder / "alpha.oil", st), 0.0, 1.0)
+        film = np.bincount(st.base_cell, alpha * st.cell_volumes, minlength=n) / st.footprint
+        mid = st.mid_gap(alpha, geom.n_layers)
+        wet = axis & (mid > 0.5)
+        if not wet.any():
+            continue
+        x_r = float(x[wet].max())
+        h_r = float(np.median(gap[axis & (np.abs(x - x_r) <= 0.1)]))
+        row = {"time_s": t, "transits": t / geom.transit_time, "rear_over_a": x_r,
+               "gap_at_rear_m": h_r, "film_over_ll": []}
+        for d0, d1 in bins:
+            sel = (y < 1.0) & (x > x_r + d0) & (x < x_r + d1) & (mid < 0.05)
+            row["film_over_ll"].append(float(np.median(film[sel]) / h_r / ll)
+                                       if sel.any() else None)
+        writes.append(row)
+    return {"case": str(case), "landau_levich_both_walls_over_gap": ll,
+            "bins_over_a": [list(b) for b in bins], "writes": writes}
+
+
+def _print_rear(result: dict) -> None:
+    print(f"\n{result['case']}  (LL both films {result['landau_levich_both_walls_over_gap']:.4f}"
+          " of the gap)")
+    print("transits  rear (a)  gap (um)  " + "  ".join(
+        f"f/LL {d0:g}-{d1:g} a" for d0, d1 in result["bins_over_a"]))
+    for w in result["writes"]:
+        print(f"{w['transits']:8.3f}  {w['rear_over_a']:8.2f}  {w['gap_at_rear_m'] * 1e6:8.1f}  "
+              + "  ".join("        -" if f is None else f"{f:13.3f}"
+                          for f in w["film_over_ll"]))
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("cases", nargs="+", type=Path)
     ap.add_argument("--save", help="write the rows to bench/results/NAME.json")
+    ap.add_argument("--rear", action="store_true",
+                    help="the films behind the rear meniscus, write by write")
+    ap.add_argument("--bins", nargs="+", type=float, default=[1.0, 2.0],
+                    help="with --rear: pairs d0 d1 [a] behind the rear meniscus (default 1 2)")
+    ap.add_argument("--from", dest="start", type=float, default=0.0,
+                    help="with --rear: the first write read [transits]")
     args = ap.parse_args(argv)
+    if args.rear:
+        if len(args.bins) % 2 or any(d1 <= d0 for d0, d1 in zip(args.bins[::2], args.bins[1::2])):
+            ap.error(f"--bins {args.bins}: give pairs d0 d1 with d1 > d0 (a)")
+        bins = list(zip(args.bins[::2], args.bins[1::2]))
+        results = [rear_films(c, bins, args.start) for c in args.cases]
+        for r in results:
+            _print_rear(r)
+        if args.save:
+            print(f"wrote {save(args.save, results)}")
+        return 0
     rows = [films(c) for c in args.cases]
     print(f"{'case':44s} {'cells':>6s} {'wall cell':>9s} {'LL':>6s} | behind: oil/gap  disc  ball "
           f"| beside: oil/gap  disc  ball")

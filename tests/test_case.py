@@ -1028,3 +1028,35 @@ def test_region_fill_is_the_oil_ahead_of_a_plane_over_the_supply(small_case, tmp
     # one write alone gives no fill
     with pytest.raises(ValueError, match="needs two"):
         region_fill(case, [3.0], from_transits=3e-3 / geom.transit_time)
+
+
+def test_rear_films_read_a_known_film_behind_a_known_rear_meniscus(small_case, tmp_path):
+    """bench/wall_films.py --rear on one write by hand: oil wall to wall ahead of x = 3 a,
+    behind it a film of H = 0.4 um of oil in every column (spread over its cells at under 5 %),
+    so the film over the gap at the rear meniscus is H / h_r whatever the gap does behind it."""
+    from bench.wall_films import rear_films
+
+    case = _copy(small_case, tmp_path)
+    geom = load_geometry(case)
+    st = case_fields.Structure.load(case)
+    n = len(st.base_x)
+    gap = np.bincount(st.base_cell, st.cell_volumes, minlength=n) / st.footprint
+    film = 0.4e-6
+    x = st.base_x[st.base_cell] / geom.a
+    alpha = np.where(x < 3.0, 1.0, film / gap[st.base_cell])
+    assert alpha[x >= 3.0].max() < 0.05
+    folder = case / "0.001"
+    folder.mkdir()
+    shutil.copy(case / "0.orig" / "alpha.oil", folder / "alpha.oil")
+    FoamFieldFile(folder / "alpha.oil").internal_field = alpha
+
+    res = rear_films(case, [(0.5, 1.5), (90.0, 99.0)])
+    (w,) = res["writes"]
+    on_axis = np.abs(st.base_y) / geom.a < 0.15
+    assert w["rear_over_a"] == pytest.approx(st.base_x[on_axis & (st.base_x < 3.0 * geom.a)].max()
+                                             / geom.a)
+    near_rear = on_axis & (np.abs(st.base_x / geom.a - w["rear_over_a"]) <= 0.1)
+    assert gap[near_rear].min() <= w["gap_at_rear_m"] <= gap[near_rear].max()
+    ll = res["landau_levich_both_walls_over_gap"]
+    assert w["film_over_ll"][0] * ll * w["gap_at_rear_m"] == pytest.approx(film, rel=1e-9)
+    assert w["film_over_ll"][1] is None                # no column 90-99 a behind the rear
