@@ -16,9 +16,13 @@ interval: exact by conservation, with no flux to interpolate. Where fill(X) is 0
 is at its balance; its change with the oil held says how far off that is.
 
     python bench/region_fill.py CASE [CASE ...] [--planes 14 16] [--from T] [--save NAME.json]
+        [--plot OUT.png [--labels L ...]]
 
 Prints, per case and write, the oil ahead of each plane and the fill over the interval up to
 that write, and the fill over all the writes from T transits on (first to last write).
+``--plot`` draws the fill at the first plane against time for each case, beside the films
+their rear meniscus lays (``bench/wall_films.py --rear``, 1-2 a behind it, over
+Landau-Levich).
 """
 from __future__ import annotations
 
@@ -100,6 +104,36 @@ def _print(result: dict) -> None:
     print("overall   " + "  ".join(f"{'':10s}  {f:5.2f}" for f in result["fill"]))
 
 
+def plot(out: Path, results: list[dict], labels: list[str]) -> None:
+    """The fill at each case's first plane and its rear films against time, one line a case."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from bench.wall_films import rear_films
+
+    fig, (ax_fill, ax_film) = plt.subplots(1, 2, figsize=(10, 4), sharex=True)
+    for r, label in zip(results, labels):
+        t = np.array(r["times_s"]) / r["transit_s"]
+        fill = np.array(r["fill_per_interval"])[:, 0]
+        ax_fill.plot(0.5 * (t[1:] + t[:-1]), fill, "o-", ms=3, label=label)
+        films = rear_films(Path(r["case"]), [(1.0, 2.0)], r["from_transits"])["writes"]
+        ax_film.plot([w["transits"] for w in films], [w["film_over_ll"][0] for w in films],
+                     "o-", ms=3, label=label)
+    ax_fill.set_ylabel(f"fill ahead of x = {results[0]['planes_over_a'][0]:g} a "
+                       "(share of the supply kept)")
+    ax_film.set_ylabel("films 1-2 a behind the rear meniscus / Landau-Levich")
+    ax_film.axhline(1.0, color="0.6", lw=0.8, ls="--")
+    for ax in (ax_fill, ax_film):
+        ax.set_xlabel("transits since the start")
+        ax.grid(alpha=0.3)
+    ax_fill.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out, dpi=130)
+    plt.close(fig)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("cases", nargs="+", type=Path)
@@ -108,12 +142,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--from", dest="start", type=float, default=0.0,
                     help="first write read [transits] (default 0)")
     ap.add_argument("--save", help="write bench/results/NAME.json")
+    ap.add_argument("--plot", type=Path, help="draw the fill and the rear films to OUT.png")
+    ap.add_argument("--labels", nargs="+", help="with --plot: one label a case")
     args = ap.parse_args(argv)
+    if args.labels and len(args.labels) != len(args.cases):
+        ap.error(f"--labels has {len(args.labels)} labels for {len(args.cases)} cases")
     results = [region_fill(c, args.planes, args.start) for c in args.cases]
     for r in results:
         _print(r)
     if args.save:
         save(args.save, {"command": " ".join(sys.argv), "results": results})
+    if args.plot:
+        plot(args.plot, results, args.labels or [str(c) for c in args.cases])
+        print(f"wrote {args.plot}")
     return 0
 
 
