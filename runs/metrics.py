@@ -583,3 +583,28 @@ def meniscus_contours(r: Raster, threshold: float = 0.5) -> list[np.ndarray]:
     z = np.ma.masked_array(np.nan_to_num(r.alpha, nan=0.0), mask=r.island)
     gen = contourpy.contour_generator(x=r.x, y=r.y, z=z, line_type=contourpy.LineType.Separate)
     return [np.asarray(line, dtype=float) for line in gen.lines(threshold) if len(line) >= 2]
+
+
+def flooded_widths_at(r: Raster, x_stations: Any, threshold: float = 0.5) -> list[float | None]:
+    """The flooded region's width [m] across y at each x of ``x_stations`` [m]: on the
+    raster column nearest each x, from its lowest to its highest pixel of the region, each
+    end at the interpolated ``alpha = threshold`` crossing (as ``flooded_width_over_a``,
+    which is their largest over all x); None where the region does not reach that column.
+    The outline behind the widest point (the rear shoulders) moves with the mesh where the
+    widest point does not (docs/cases.md)."""
+    threshold = _check_threshold(threshold)
+    if not isinstance(r, Raster):
+        raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
+    oil, gas = r.oil(threshold), r.gas(threshold)
+    flooded = _flooded(oil, _rim_mask(r.island))
+    alpha = np.nan_to_num(r.alpha, nan=0.0)
+    widths: list[float | None] = []
+    for x in np.atleast_1d(np.asarray(x_stations, float)):
+        j = int(np.argmin(np.abs(r.x - x)))
+        column = flooded[:, j][None, :]
+        if not column.any():
+            widths.append(None)
+            continue
+        lo, hi = _extent(column, alpha[:, j][None, :], gas[:, j][None, :], r.y, threshold)
+        widths.append(float(hi - lo))
+    return widths

@@ -13,7 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from runs.metrics import Geometry, Raster, flow_pattern, meniscus_contours, raster
+from runs.metrics import (Geometry, Raster, flooded_widths_at, flow_pattern, meniscus_contours,
+                          raster)
 
 A = 1.371e-4
 GEOM = Geometry(a=A, island_radius=1.5 * A, x_min=-6 * A, x_max=12 * A, y_max=6 * A)
@@ -355,3 +356,21 @@ def test_the_advancing_front_is_the_upstream_edge_off_the_track():
     assert len(advancing_front(r, 5 * A)) == 0
     with pytest.raises(ValueError, match="track_half_width"):
         advancing_front(r, -1.0)
+
+
+def test_flooded_widths_at_follow_a_known_outline():
+    """A ring of radius 4 a: the width at x is 2 sqrt(16 a^2 - x^2) (at x = 0 the region's
+    width); none beyond it; an oil patch detached from the region does not count."""
+    x, y = centres()
+    detached = box(x, y, 7 * A, 9 * A, 1.5 * A)
+    r = raster(x, y, alpha_of(np.minimum(ring(x, y), detached)), GEOM)
+    stations = np.array([-3.0, 0.0, 2.0, 3.5, 8.0]) * A
+    widths = flooded_widths_at(r, stations)
+    assert widths[-1] is None                              # the patch at 7-9 a is not flooded
+    expected = 2.0 * np.sqrt(16.0 - (stations[:-1] / A) ** 2)
+    # the nearest raster column is up to half a pixel off the station: where the outline is
+    # steep (3.5 a) that moves the width by its slope times half a pixel
+    slope = 2.0 * np.abs(stations[:-1] / A) / np.sqrt(16.0 - (stations[:-1] / A) ** 2)
+    error = np.abs(np.array(widths[:-1]) / A - expected)
+    assert np.all(error <= 2 * TOL + slope * r.dx / A / 2), error
+    assert widths[1] / A == pytest.approx(pattern(ring)["flooded_width_over_a"], abs=TOL)

@@ -1,0 +1,80 @@
+"""The flooded region's outline along x: its width at stations x / a, from one or more runs,
+averaged over the writes of a window, to compare meshes where the widest point agrees but
+the shoulders behind it may not.
+
+    python bench/region_outline.py CASE[@T] [CASE[@T] ...] [--stations -4 -2 0 2 4 6 8 10]
+        [--window W] [--save NAME.json]
+
+For each case, the writes within W transits (default 0.1) up to T transits (default: its last
+write) are read; at each of them the mid-gap oil is rastered as the run's metrics do and the
+region's width at each station measured (:func:`runs.metrics.flooded_widths_at`); printed are
+the means over the writes and, for more than one case, each case's difference from the first.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from bench.common import save  # noqa: E402
+from bench.plot_midgap import _pick  # noqa: E402
+from generator.case_writer import load_geometry  # noqa: E402
+from runs import case_fields, metrics  # noqa: E402
+
+
+def outline(case: Path, at: float | None, stations_over_a: list[float],
+            window: float = 0.1) -> dict:
+    """Mean widths [a] of the flooded region at ``stations_over_a`` over the writes within
+    ``window`` transits up to ``at`` transits (the last write for None), and their spread."""
+    g = load_geometry(case)
+    st = case_fields.Structure.load(case)
+    times = case_fields.time_folders(case)
+    if not times:
+        raise ValueError(f"{case} has no written time folders")
+    t_end = times[-1][0] if at is None else min(times, key=lambda tf: abs(tf[0] - at * g.transit_time))[0]
+    picked = [(t, f) for t, f in times if t_end - window * g.transit_time - 1e-12 <= t <= t_end]
+    rows = []
+    for _, folder in picked:
+        mid = case_fields.mid_gap_alpha(folder, st, g)
+        r = metrics.raster(st.base_x, st.base_y, mid, case_fields.pattern_geometry(g))
+        widths = metrics.flooded_widths_at(r, np.asarray(stations_over_a) * g.a)
+        rows.append([np.nan if w is None else w / g.a for w in widths])
+    w = np.array(rows)
+    return {"case": str(case), "to_transits": t_end / g.transit_time, "window": window,
+            "writes": len(rows), "stations_over_a": stations_over_a,
+            "width_over_a": np.nanmean(w, axis=0).tolist(),
+            "width_sd_over_a": np.nanstd(w, axis=0).tolist()}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("cases", nargs="+", help="CASE or CASE@TRANSITS")
+    ap.add_argument("--stations", nargs="+", type=float,
+                    default=[-4.0, -2.0, 0.0, 2.0, 4.0, 6.0, 8.0, 10.0], help="x / a")
+    ap.add_argument("--window", type=float, default=0.1,
+                    help="transits up to each case's time averaged over (default 0.1)")
+    ap.add_argument("--save", help="write bench/results/NAME.json")
+    args = ap.parse_args(argv)
+    if args.window < 0.0:
+        ap.error(f"--window = {args.window}: must be >= 0 (transits)")
+    results = [outline(*_pick(c), args.stations, args.window) for c in args.cases]
+    print("x / a:" + " " * 41 + "".join(f"{x:7.1f}" for x in args.stations))
+    first = np.array(results[0]["width_over_a"])
+    for r in results:
+        label = f"{r['case'][-30:]:30s} to {r['to_transits']:5.3f} ({r['writes']:2d} writes)"
+        print(f"{label:47s}" + "".join(f"{v:7.2f}" for v in r["width_over_a"]))
+        if r is not results[0]:
+            diff = np.array(r["width_over_a"]) - first
+            print(f"{'  - first':47s}" + "".join(f"{v:+7.2f}" for v in diff))
+    if args.save:
+        save(args.save, {"command": " ".join(sys.argv), "results": results})
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
