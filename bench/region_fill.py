@@ -2,8 +2,9 @@
 planes x = X behind the contact, write by write.
 
 A run's outflow through its outlet lags the region by the time the walls take to carry the
-films there (the outlet 7 a behind the rear meniscus is 0.2 transits), and right after a run
-starts from another mesh's fields most of it is film laid down before the start. The oil
+films there (the 7 a from the rear meniscus to the outlet take 7 a / u, 0.7 of a 10 a
+transit), and right after a run starts from another mesh's fields most of it is film laid
+down before the start. The oil
 ahead of a plane just behind the rear meniscus, V(X) = sum(alpha V) over the cells whose
 column centre lies at x < X (whole contact, doubled in a half domain), changes only by what
 the supply brings in and what crosses the plane (nothing leaves through the side or the

@@ -36,7 +36,8 @@ def outline(case: Path, at: float | None, stations_over_a: list[float],
     times = case_fields.time_folders(case)
     if not times:
         raise ValueError(f"{case} has no written time folders")
-    t_end = times[-1][0] if at is None else min(times, key=lambda tf: abs(tf[0] - at * g.transit_time))[0]
+    t_end = (times[-1][0] if at is None
+             else min(times, key=lambda tf: abs(tf[0] - at * g.transit_time))[0])
     picked = [(t, f) for t, f in times if t_end - window * g.transit_time - 1e-12 <= t <= t_end]
     rows = []
     for _, folder in picked:

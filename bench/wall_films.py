@@ -23,7 +23,7 @@ column over h_r, against LL (medians over the columns with air at mid-gap on |y|
 x_r + d0 < x < x_r + d1, for each ``--bins`` pair d0 d1 in a; default 1-2 a, past the wedges of
 oil the meniscus leaves along both walls, some h_r / 2 beyond its apex). The walls carry a film
 laid at t0 to x_r + u (t - t0): a run that starts from other fields shows its own films in a
-bin d1 only after d1 / 10 transits (a transit is 10 a).
+bin up to d1 only after d1 a / u (0.1 d1 transits where a transit is 10 a).
 
     python bench/wall_films.py CASE [CASE ...] --rear [--bins 1 2] [--from T] [--save NAME.json]
 """
