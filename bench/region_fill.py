@@ -37,6 +37,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
+from bench.oil_change import columns  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
 from runs import case_fields  # noqa: E402
 from runs.convergence import history_number, read_history_rows  # noqa: E402
@@ -44,12 +45,11 @@ from runs.convergence import history_number, read_history_rows  # noqa: E402
 NL = 1e-12  # m3 per nanolitre
 
 
-def oil_ahead(alpha: np.ndarray, structure: case_fields.Structure, a: float, mirror: float,
+def oil_ahead(oil: np.ndarray, structure: case_fields.Structure, a: float, mirror: float,
               planes_over_a: list[float]) -> list[float]:
-    """The oil [m3, whole contact] in the cells whose column centre lies at x < X, for each
-    plane X [a], of the oil fractions ``alpha`` per cell."""
-    x = structure.base_x[structure.base_cell] / a
-    oil = np.clip(alpha, 0.0, 1.0) * structure.cell_volumes
+    """The oil [m3, whole contact] in the columns whose centre lies at x < X, for each plane
+    X [a], of the oil per column ``oil`` [m3, as meshed]."""
+    x = structure.base_x / a
     return [mirror * float(oil[x < X].sum()) for X in planes_over_a]
 
 
@@ -75,9 +75,9 @@ def region_fill(case: str | Path, planes_over_a: list[float],
         q = inflow.get(round(t, 9))
         if t < from_transits * geom.transit_time - 1e-12 or q is None:
             continue
-        alpha = case_fields.read_alpha(folder / "alpha.oil", structure)
+        oil, _ = columns(folder, structure, geom.n_layers)
         times.append(t)
-        ahead.append(oil_ahead(alpha, structure, geom.a, geom.mirror, planes_over_a))
+        ahead.append(oil_ahead(oil, structure, geom.a, geom.mirror, planes_over_a))
         q_in.append(q)
     if len(times) < 2:
         raise ValueError(f"{case} has {len(times)} write(s) in its history from "

@@ -38,6 +38,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
+from bench.oil_change import columns  # noqa: E402
 from ehl_precalc.meniscus_reynolds import landau_levich  # noqa: E402
 from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
 from generator.mesh import layer_fractions  # noqa: E402
@@ -95,9 +96,8 @@ def rear_films(case: Path, bins: list[tuple[float, float]] = ((1.0, 2.0),),
     for t, folder in case_fields.time_folders(case):
         if t < from_transits * geom.transit_time - 1e-12:
             continue
-        alpha = np.clip(case_fields.read_alpha(folder / "alpha.oil", st), 0.0, 1.0)
-        film = np.bincount(st.base_cell, alpha * st.cell_volumes, minlength=n) / st.footprint
-        mid = st.mid_gap(alpha, geom.n_layers)
+        oil, mid = columns(folder, st, geom.n_layers)
+        film = oil / st.footprint
         wet = axis & (mid > 0.5)
         if not wet.any():
             continue
