@@ -33,12 +33,9 @@ def outline(case: Path, at: float | None, stations_over_a: list[float],
     ``window`` transits up to ``at`` transits (the last write for None), and their spread."""
     g = load_geometry(case)
     st = case_fields.Structure.load(case)
-    times = case_fields.time_folders(case)
-    if not times:
-        raise ValueError(f"{case} has no written time folders")
-    t_end = (times[-1][0] if at is None
-             else min(times, key=lambda tf: abs(tf[0] - at * g.transit_time))[0])
-    picked = [(t, f) for t, f in times if t_end - window * g.transit_time - 1e-12 <= t <= t_end]
+    t_end, _ = case_fields.write_near(case, "last" if at is None else str(at), g.transit_time)
+    picked = [(t, f) for t, f in case_fields.time_folders(case)
+              if t_end - window * g.transit_time - 1e-12 <= t <= t_end]
     rows = []
     for _, folder in picked:
         mid = case_fields.mid_gap_alpha(folder, st, g)
