@@ -47,6 +47,7 @@ from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
 from generator.case_writer import (TEMPLATES, capillary_time_step,  # noqa: E402
                                    edit_physics_dicts, edit_run_control)
 from generator.gap_source import load_gap  # noqa: E402
+from generator import mesh as mesh_module  # noqa: E402
 from generator.mesh import BaseMesh, PolyMesh, extrude, split_patch, write_polymesh  # noqa: E402
 from runs import case_fields  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
@@ -59,12 +60,35 @@ X_IN, X_OUT = 3.0, 16.0
 FILM = 4e-6
 
 
+def supply_cell_size(gap, x_in: float) -> float:
+    """The smallest in-plane cell (m) at the supply x_in (m): twice the lean h h' / 2 of the
+    columns there at the ball (``extrude``'s normal columns lean upstream onto the supply's
+    upright ones, and turn the first cells inside out where these are finer than the lean;
+    0.05 a at 9 a on the nominal gap)."""
+    eps = 1e-3 * x_in
+    h = float(gap(np.array([x_in]), np.array([0.0]))[0])
+    slope = float(np.diff(gap(np.array([x_in - eps, x_in + eps]), np.zeros(2)))[0]) / (2 * eps)
+    return h * abs(slope)
+
+
+def cell_size(x: float, x_in: float, dx: float, s_in: float) -> float:
+    """The in-plane cell size (m) at x (m): dx, grown to s_in (m) at the supply x_in over
+    20 s_in where s_in is larger (:func:`supply_cell_size`)."""
+    return max(dx, s_in * (1.0 - (x - x_in) / (20.0 * s_in)))
+
+
 def strip_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float) -> PolyMesh:
-    """The strip x in [x_in, x_out] (m), one cell of dx (m) wide in y, extruded across the gap
-    on y = 0 with the level's wall layers; patches supply (x_in), outlet, disc, ball and
-    side (both y faces, empty: a 2D case)."""
-    n = max(int(round((x_out - x_in) / dx)), 1)
-    x = np.linspace(x_in, x_out, n + 1)
+    """The strip x in [x_in, x_out] (m), one cell wide in y, of dx (m), coarser near the supply
+    where dx is finer than :func:`supply_cell_size`, extruded across the gap on y = 0 with the
+    level's wall layers; patches supply (x_in), outlet, disc, ball and side (both y faces,
+    empty: a 2D case)."""
+    s_in = supply_cell_size(gap, x_in)
+    graded = [x_in]
+    while s_in > dx and graded[-1] < x_in + 20.0 * s_in:
+        graded.append(graded[-1] + cell_size(graded[-1], x_in, dx, s_in))
+    n_uniform = max(int(round((x_out - graded[-1]) / dx)), 1)
+    x = np.concatenate([graded[:-1], np.linspace(graded[-1], x_out, n_uniform + 1)])
+    n = len(x) - 1
     points = np.concatenate([np.stack([x, np.zeros_like(x)], 1),
                              np.stack([x, np.full_like(x, dx)], 1)])
     i = np.arange(n)
@@ -80,17 +104,86 @@ def strip_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float) -> Pol
     return mesh
 
 
-def columns(mesh: PolyMesh, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per column of the strip: x on the disc (m), gap (m) and oil thickness (m, both walls
-    together)."""
-    x_nodes = np.unique(mesh.points[mesh.points[:, 2] == 0.0, 0])   # the disc's nodes
-    footprint = np.diff(x_nodes) * np.ptp(mesh.points[:, 1])
-    n = len(footprint)
-    x = 0.5 * (x_nodes[:-1] + x_nodes[1:])
-    gap_h = np.bincount(mesh.base_cell, mesh.cell_volumes, minlength=n) / footprint
-    oil = np.bincount(mesh.base_cell, mesh.cell_volumes * np.clip(alpha, 0.0, 1.0),
-                      minlength=n) / footprint
-    return x, gap_h, oil
+def slab_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float,
+              width: float, free: bool = True) -> PolyMesh:
+    """The strip as a slab ``width`` (m) wide in y, meshed in (x, y) with gmsh's free quads of
+    size dx (m), the generator's own algorithm (``free``), or with rows of square cells along x
+    (not ``free``: the strip repeated across y; uniform, so ``dx`` must not be finer than
+    half :func:`supply_cell_size`, the columns' lean), and extruded like the strip on the gap of
+    y = 0 (the same gap at every y); both y faces are symmetry planes (``symmetry`` at y = 0,
+    ``side`` at y = width). Still a 2D problem, on free quads now on cells that do not line up
+    with the meniscus, as in the 3D cases' bands."""
+    import gmsh
+    s_in = supply_cell_size(gap, x_in)
+    if not free and dx < 0.5 * s_in:
+        raise ValueError(f"dx = {dx:.3g} m: aligned slab cells must be at least the columns' "
+                         f"lean at x_in = {x_in:.3g} m, {0.5 * s_in:.3g} m")
+    with mesh_module._gmsh_model("film-slab"):
+        surface = gmsh.model.occ.addRectangle(x_in, 0.0, 0.0, x_out - x_in, width)
+        gmsh.model.occ.synchronize()
+        if not free:
+            for _, curve in gmsh.model.getBoundary([(2, surface)], oriented=False):
+                x0, y0, _, x1, y1, _ = gmsh.model.getBoundingBox(1, curve)
+                gmsh.model.mesh.setTransfiniteCurve(
+                    curve, max(int(round(max(x1 - x0, y1 - y0) / dx)), 1) + 1)
+            gmsh.model.mesh.setTransfiniteSurface(surface)
+            gmsh.model.mesh.setRecombine(2, surface)
+        gmsh.model.mesh.setSizeCallback(
+            lambda dim, tag, x, y, z, lc: cell_size(x, x_in, dx, s_in))
+        gmsh.model.mesh.generate(2)
+        _, coords, _ = gmsh.model.mesh.getNodes()
+        tags, _, nodes = gmsh.model.mesh.getElements(dim=2)
+        node_tags = gmsh.model.mesh.getNodes()[0]
+    if any(int(t) != 3 for t in tags):
+        raise RuntimeError("gmsh left non-quadrilateral elements in the slab")
+    index = np.full(int(node_tags.max()) + 1, -1)
+    index[node_tags.astype(int)] = np.arange(len(node_tags))
+    points = np.asarray(coords).reshape(-1, 3)[:, :2]
+    quads = index[np.asarray(nodes[0], int).reshape(-1, 4)]
+    base = BaseMesh(points, quads)
+    quads = np.where((base.quad_areas() < 0)[:, None], quads[:, ::-1], quads)
+    # boundary edges: those of one quad only, kept in their quad's (counter-clockwise) order
+    edges = np.stack([quads, np.roll(quads, -1, axis=1)], axis=2).reshape(-1, 2)
+    key = np.sort(edges, axis=1) @ np.array([len(points), 1])
+    _, first, count = np.unique(key, return_index=True, return_counts=True)
+    outer = edges[first[count == 1]]
+    mid = points[outer].mean(axis=1)
+    tol = 1e-6 * dx
+    names = {"inlet": np.abs(mid[:, 0] - x_in) < tol, "outlet": np.abs(mid[:, 0] - x_out) < tol,
+             "symmetry": np.abs(mid[:, 1]) < tol, "side": np.abs(mid[:, 1] - width) < tol}
+    level = spec.mesh.level()
+    mesh = extrude(BaseMesh(points, quads, {k: outer[v] for k, v in names.items()}),
+                   lambda xs, ys: gap(xs, np.zeros_like(xs)),
+                   level["n_layers"], level["wall_grading"], spec.mesh.columns)
+    mesh = split_patch(mesh, "inlet", np.ones(mesh.patch("inlet").size, bool), "supply")
+    mesh.patches = [replace(p, type="symmetryPlane") if p.name == "side" else p
+                    for p in mesh.patches]
+    return mesh
+
+
+def columns(mesh: PolyMesh, alpha: np.ndarray, x_edges: np.ndarray | None = None
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per column of the strip, in x order, or per bin of x between ``x_edges`` (m) over the
+    columns whose disc face lies in it (a slab): x (m), gap (m) and oil thickness (m, both
+    walls together)."""
+    disc = mesh.patch_slice("disc")
+    base = mesh.base_cell[mesh.owner[disc]]
+    n = int(mesh.base_cell.max()) + 1
+    area, x_base = np.zeros(n), np.zeros(n)
+    area[base] = np.linalg.norm(mesh.face_areas[disc], axis=1)
+    x_base[base] = mesh.face_centres[disc, 0]
+    volume = np.bincount(mesh.base_cell, mesh.cell_volumes, minlength=n)
+    oil = np.bincount(mesh.base_cell, mesh.cell_volumes * np.clip(alpha, 0.0, 1.0), minlength=n)
+    if x_edges is None:
+        order = np.argsort(x_base)
+        return x_base[order], volume[order] / area[order], oil[order] / area[order]
+    m = len(x_edges) - 1
+    k = np.clip(np.searchsorted(x_edges, x_base) - 1, 0, m - 1)
+    footprint = np.bincount(k, area, minlength=m)
+    held = footprint > 0           # bins finer than the cells near the supply may hold none
+    return (0.5 * (x_edges[:-1] + x_edges[1:]))[held], \
+        (np.bincount(k, volume, minlength=m) / np.where(held, footprint, 1.0))[held], \
+        (np.bincount(k, oil, minlength=m) / np.where(held, footprint, 1.0))[held]
 
 
 def write_strip_case(spec: CaseSpec, case: Path, mesh: PolyMesh, x_bridge: float,
@@ -103,6 +196,7 @@ def write_strip_case(spec: CaseSpec, case: Path, mesh: PolyMesh, x_bridge: float
     for part in ("system", "constant", "0.orig"):
         shutil.copytree(TEMPLATES / "interface" / part, case / part)
     write_polymesh(mesh, case)
+    side = mesh.patch("side").type             # empty on the strip, symmetryPlane on a slab
     u = spec.wall_speed
     h_in = mesh.points[mesh.faces[mesh.patch_slice("supply")], 2].max()   # the gap at x_in
     with FoamFieldFile(case / "0.orig" / "U") as f:
@@ -110,14 +204,14 @@ def write_strip_case(spec: CaseSpec, case: Path, mesh: PolyMesh, x_bridge: float
         f.boundary_field["ball"]["origin"] = np.array([0.0, 0.0, spec.contact.radius])
         f.boundary_field["ball"]["omega"] = -u / spec.contact.radius
         f.boundary_field["supply"]["value"] = np.array([u * film / h_in, 0.0, 0.0])
-        f.boundary_field["side"] = {"type": "empty"}
+        f.boundary_field["side"] = {"type": side}
     with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
         f.internal_field = (mesh.cell_centres[:, 0] < x_bridge).astype(float)
         f.boundary_field['"(disc|ball|island)"']["theta0"] = spec.physics.contact_angle
         f.boundary_field["supply"]["value"] = 1.0
-        f.boundary_field["side"] = {"type": "empty"}
+        f.boundary_field["side"] = {"type": side}
     with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
-        f.boundary_field["side"] = {"type": "empty"}
+        f.boundary_field["side"] = {"type": side}
     edit_physics_dicts(spec, case)
     dt = capillary_time_step(spec, dx)
     edit_run_control(spec, case, end_time, write_interval, min(dt, write_interval))
@@ -135,14 +229,16 @@ def x_at_gap(gap, h: float, x_lo: float, x_hi: float) -> float:
     return brentq(g, x_lo, x_hi, xtol=1e-12)
 
 
-def measure(case: Path, mesh: PolyMesh, a: float, x_out: float) -> list[dict]:
+def measure(case: Path, mesh: PolyMesh, a: float, x_out: float,
+            x_edges: np.ndarray | None = None) -> list[dict]:
     """At every write: the rear meniscus x_r/a and the gap there (m), the films behind it (m,
-    both walls) and the oil held per metre of width (m2)."""
-    x, h, _ = columns(mesh, np.zeros(len(mesh.cell_volumes)))
+    both walls) and the oil held per metre of width (m2); on a slab, over the bins of x
+    between ``x_edges`` (m)."""
+    x, h, _ = columns(mesh, np.zeros(len(mesh.cell_volumes)), x_edges)
     rows = []
     for t, folder in case_fields.time_folders(case):
         alpha = np.asarray(FoamFieldFile(folder / "alpha.oil").internal_field, float)
-        _, _, oil = columns(mesh, alpha)
+        _, _, oil = columns(mesh, alpha, x_edges)
         frac = oil / h
         dry = np.flatnonzero(frac < 0.5)
         if not len(dry) or dry[0] == 0:
@@ -155,7 +251,8 @@ def measure(case: Path, mesh: PolyMesh, a: float, x_out: float) -> list[dict]:
         film = float(np.median(oil[behind])) if behind.any() else float("nan")
         rows.append({"t_s": t, "x_rear_over_a": x_r / a, "gap_rear_m": h_r, "film_m": film,
                      "deposited_fraction": film / h_r,
-                     "oil_per_width_m2": float(oil.sum() * np.diff(x).mean())})
+                     "oil_per_width_m2": float(np.sum(np.clip(alpha, 0.0, 1.0) * mesh.cell_volumes)
+                                               / np.ptp(mesh.points[:, 1]))})
     return rows
 
 
@@ -226,10 +323,17 @@ def main(argv: list[str] | None = None) -> int:
                     help="oil carried in, as a film thickness at the rolling speed [m]")
     ap.add_argument("--x-in", type=float, default=X_IN, help="supply at x = X a")
     ap.add_argument("--x-out", type=float, default=X_OUT, help="outlet at x = X a")
+    ap.add_argument("--width", type=float, default=0.0,
+                    help="0: the strip, one cell wide; W > 0: a slab W a wide of free quads "
+                         "with symmetry planes on both sides")
+    ap.add_argument("--aligned", action="store_true",
+                    help="with --width: rows of square cells along x instead of free quads")
     args = ap.parse_args(argv)
     for name, value in (("--film", args.film), ("--time", args.time)):
         if not value > 0:
             ap.error(f"{name}: {value} (valid range > 0)")
+    if not 0.0 <= args.width <= 10.0:
+        ap.error(f"--width {args.width}: valid range 0 (the strip) to 10 (a)")
     if not 1.5 <= args.x_in < args.x_out:
         ap.error(f"--x-in {args.x_in}, --x-out {args.x_out}: need 1.5 <= x_in < x_out (a)")
     runtime = FoamRuntime.from_environment()
@@ -237,13 +341,21 @@ def main(argv: list[str] | None = None) -> int:
     for level, dx_a, spec, gap, a in sweep(args):
         ll = landau_levich(spec.oil_viscosity, spec.speed, spec.physics.surface_tension)
         x_ll = x_at_gap(gap, args.film / ll, args.x_in * a, args.x_out * a)
-        mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
+        x_edges = None
+        if args.width:
+            mesh = slab_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a, args.width * a,
+                             free=not args.aligned)
+            x_edges = np.linspace(args.x_in * a, args.x_out * a,
+                                  max(int(round((args.x_out - args.x_in) / dx_a)), 1) + 1)
+        else:
+            mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
         strip = ("" if (args.x_in, args.x_out) == (X_IN, X_OUT)
-                 else f"_x{args.x_in:g}-{args.x_out:g}")
+                 else f"_x{args.x_in:g}-{args.x_out:g}") + (
+            f"_w{args.width:g}" + ("_aligned" if args.aligned else "") if args.width else "")
         case = args.work / (f"{level}_dx{dx_a:g}{strip}" + "".join(
             f"_{k.split('.')[-1]}{v}" for k, v in args.set))
         run = run_or_reuse(runtime, spec, case, mesh, x_ll, args, dx_a * a)
-        rows = measure(case, mesh, a, args.x_out * a)
+        rows = measure(case, mesh, a, args.x_out * a, x_edges)
         late = [r for r in rows if r["t_s"] >= 0.6 * args.time]
         f = float(np.median([r["deposited_fraction"] for r in late])) if late else float("nan")
         h_star = args.film / f

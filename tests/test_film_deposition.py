@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 from foamlib import FoamFile
 
-from bench.film_deposition import columns, measure, strip_mesh, write_strip_case, x_at_gap
+from bench.film_deposition import (columns, measure, slab_mesh, strip_mesh, supply_cell_size,
+                                   write_strip_case, x_at_gap)
 from generator.case_spec import make_case_spec
 from generator.gap_source import load_gap
 from runs.foam_runtime import FoamRuntime
@@ -60,3 +61,43 @@ def test_a_fed_bridge_runs_and_lays_films_behind_its_rear_meniscus(strip, tmp_pa
     assert 6.5 < last["x_rear_over_a"] < 7.5            # a bridge, not drained nor spilled
     assert 0 < last["film_m"] < 0.3 * last["gap_rear_m"]   # the walls carry films out
     assert last["oil_per_width_m2"] > 0
+
+
+def test_cells_finer_than_the_columns_lean_at_the_supply_stay_right_side_out():
+    """The normal columns lean upstream by h h' / 2 at the ball, 0.037 a at 9 a on the nominal
+    gap: uniform cells of 0.035 a from there turned the first ones inside out (the strip then
+    diverged within 2 ms); the strip and the slab now grow their cells near the supply."""
+    spec = make_case_spec({"mesh": {"resolution": "fine"}})
+    gap, _ = load_gap(spec.contact)
+    a = spec.a
+    assert 0.035 * a < supply_cell_size(gap, 9 * a) < 0.1 * a
+    strip = strip_mesh(spec, gap, 9 * a, 12 * a, 0.035 * a)
+    assert strip.cell_volumes.min() > 0
+    x, h, _ = columns(strip, np.zeros(strip.n_cells))
+    assert np.isclose(x[-1] - x[-2], 0.035 * a, rtol=0.05)          # dx where it is read
+    assert x[1] - x[0] > 1.5 * 0.035 * a                              # coarser at the supply
+    with pytest.raises(ValueError, match="aligned slab cells"):
+        slab_mesh(spec, gap, 9 * a, 12 * a, 0.035 * a, 0.2 * a, free=False)
+
+
+@pytest.mark.parametrize("free", [True, False])
+def test_a_slab_holds_the_gap_between_two_planar_symmetry_planes(strip, free):
+    spec, gap, a, _ = strip
+    mesh = slab_mesh(spec, gap, 3 * a, 10 * a, 0.5 * a, 2 * a, free=free)
+    patches = {p.name: p.type for p in mesh.patches}
+    assert patches["side"] == patches["symmetry"] == "symmetryPlane"
+    for name, sign in (("side", 1.0), ("symmetry", -1.0)):
+        normals = mesh.face_areas[mesh.patch_slice(name)]
+        assert np.all(sign * normals[:, 1] > 0) and np.allclose(normals[:, [0, 2]], 0.0)
+    assert mesh.cell_volumes.min() > 0
+    edges = np.linspace(3 * a, 10 * a, 15)
+    x, h, oil = columns(mesh, np.ones(mesh.n_cells), edges)
+    assert np.allclose(h[1:-1], gap(x, np.zeros_like(x))[1:-1], rtol=0.02)
+    assert np.allclose(oil, h)
+    # the footprint covers the slab once: the oil of a full gap is the slab's volume
+    assert np.sum(oil * np.diff(edges)) * 2 * a == pytest.approx(mesh.cell_volumes.sum())
+    if not free:     # rows of square cells: every edge on the disc along x or along y
+        disc = mesh.points[mesh.faces[mesh.patch_slice("disc")]][..., :2]
+        edges = np.roll(disc, -1, axis=1) - disc
+        assert np.allclose(np.min(np.abs(edges), axis=2), 0.0, atol=1e-9 * a)
+        assert mesh.n_cells == 14 * 4 * SMALL["mesh"]["n_layers"]
