@@ -123,6 +123,16 @@ def size_function(spec: CaseSpec):
     return size
 
 
+def smallest_cell_size(spec: CaseSpec) -> float:
+    """The smallest in-plane cell [m] :func:`size_function` asks for: the level's size at the
+    island rim, or a refinement's (mesh.refine) where it is finer. The capillary time step is
+    set for it: before 2026-11-27 it was set for the rim alone, so a band of 0.035 a cells on
+    the fine level (rim 0.055 a) ran at a step 1.6 times its own limit, and the 2D strip shows
+    films that double at such steps (docs/cases.md, "The films' own time step")."""
+    sizes = [spec.mesh.level()["size_rim"]] + [box.size for box in spec.mesh.refine]
+    return min(sizes) * spec.a
+
+
 def capillary_time_step(spec: CaseSpec, dx: float) -> float:
     """Surface-tension time-step limit [s] for in-plane cells of size dx [m].
 
@@ -496,7 +506,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
     mesh = extrude(base, gap, level["n_layers"], level["wall_grading"], spec.mesh.columns)
     steps = float(np.median(wall_steps(base, mesh)))
     mesh, supply = with_supply_patch(spec, mesh)
-    dx = level["size_rim"] * a
+    dx = smallest_cell_size(spec)
     dt = capillary_time_step(spec, dx)
     write_interval = _write_interval(spec)
     summary = _read_json(precalc / "summary.json")

@@ -216,6 +216,29 @@ def test_a_refinement_box_refines_the_free_quads_inside_it():
         make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": [{**box, "y_min": 5.0}]}})
 
 
+def test_the_capillary_step_is_set_for_the_finest_refinement(tmp_path):
+    """A refinement finer than the level's rim sets the case's capillary step (until
+    2026-11-27 the rim alone did, and a fine band ran at 1.6 times its own limit); a coarser
+    one leaves the rim's."""
+    from generator.case_writer import smallest_cell_size
+
+    box = {"x_min": 4.0, "x_max": 6.5, "y_min": 0.0, "y_max": 4.5, "size": 0.1}
+    plain = make_case_spec(SMALL)
+    boxed = make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": [box]},
+                            "run": {**SMALL["run"], "writes_per_transit": 10}})
+    coarse_box = make_case_spec({**SMALL, "mesh": {**SMALL["mesh"],
+                                                   "refine": [{**box, "size": 0.5}]}})
+    a = plain.a
+    assert smallest_cell_size(plain) == pytest.approx(SMALL["mesh"]["size_rim"] * a)
+    assert smallest_cell_size(boxed) == pytest.approx(0.1 * a)
+    assert smallest_cell_size(coarse_box) == pytest.approx(smallest_cell_size(plain))
+    geom = write_case(boxed, tmp_path / "boxed")
+    assert geom.min_cell_size == pytest.approx(0.1 * a)
+    with FoamFile(tmp_path / "boxed" / "system" / "controlDict") as f:
+        assert f["maxDeltaT"] == pytest.approx(capillary_time_step(boxed, 0.1 * a))
+    assert capillary_time_step(boxed, 0.1 * a) < 0.5 * capillary_time_step(plain, 0.25 * a)
+
+
 def test_a_band_refines_the_free_quads_along_its_line():
     """mesh.refine with points: quads of the band's size within half_width of its line, the
     level's far from it; the line is read as (x, |y|); a band with one point or below y = 0

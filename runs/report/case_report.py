@@ -93,7 +93,7 @@ def solver_table(info: CaseInfo, n_times: int) -> Table:
         rows += [["Cells", units.fmt_number(g.cells), ""],
                  ["Mesh level", level, ""],
                  ["Cells across the gap", str(g.n_layers), ""],
-                 ["Smallest in-plane cell (island rim)", f"{g.min_cell_size * 1e6:.3g}", "um"],
+                 ["Smallest in-plane cell (rim or refinement)", f"{g.min_cell_size * 1e6:.3g}", "um"],
                  ["Domain x", f"{g.x_min * 1e3:.3g} to {g.x_max * 1e3:.3g}", "mm"],
                  ["Domain y", f"{0 if g.symmetric else -g.y_max * 1e3:.3g} to "
                               f"{g.y_max * 1e3:.3g}"
