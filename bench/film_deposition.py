@@ -17,9 +17,15 @@ write, the rear meniscus (the gap-averaged oil fraction crossing 0.5), the films
 the deposited fraction f = film / h(x_r) against LL, and where the meniscus would balance,
 h* = film_in / f.
 
+With ``--width W`` the strip becomes a slab W a wide between two symmetry planes, meshed with
+gmsh's free quads (``--aligned``: rows of square cells): the same 2D problem with room across
+y, which asks what the third dimension alone does to the films (docs/cases.md, "The films' own
+time step"). Strip and slab grow their cells near the supply, where the leaning columns would
+turn cells finer than their lean inside out.
+
     python bench/film_deposition.py [--dx 0.8 0.4 0.2 0.1 0.05] [--levels coarse]
-        [--film 4e-6] [--time 1.0] [--set KEY=VALUE ...] [--work DIR] [--reuse]
-        [--save NAME.json]
+        [--film 4e-6] [--time 1.0] [--x-in 3] [--x-out 16] [--width W [--aligned]]
+        [--set KEY=VALUE ...] [--work DIR] [--reuse] [--save NAME.json]
 """
 from __future__ import annotations
 
@@ -64,7 +70,7 @@ def supply_cell_size(gap, x_in: float) -> float:
     """The smallest in-plane cell (m) at the supply x_in (m): twice the lean h h' / 2 of the
     columns there at the ball (``extrude``'s normal columns lean upstream onto the supply's
     upright ones, and turn the first cells inside out where these are finer than the lean;
-    0.05 a at 9 a on the nominal gap)."""
+    0.075 a at 9 a on the nominal gap)."""
     eps = 1e-3 * x_in
     h = float(gap(np.array([x_in]), np.array([0.0]))[0])
     slope = float(np.diff(gap(np.array([x_in - eps, x_in + eps]), np.zeros(2)))[0]) / (2 * eps)
@@ -111,8 +117,9 @@ def slab_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float,
     (not ``free``: the strip repeated across y; uniform, so ``dx`` must not be finer than
     half :func:`supply_cell_size`, the columns' lean), and extruded like the strip on the gap of
     y = 0 (the same gap at every y); both y faces are symmetry planes (``symmetry`` at y = 0,
-    ``side`` at y = width). Still a 2D problem, on free quads now on cells that do not line up
-    with the meniscus, as in the 3D cases' bands."""
+    ``side`` at y = width). Still a 2D problem, now with room across y, which the 3D cases
+    have and the strip has not, and on free quads with cells that need not line up with the
+    meniscus, as in the 3D cases' bands."""
     import gmsh
     s_in = supply_cell_size(gap, x_in)
     if not free and dx < 0.5 * s_in:
@@ -131,9 +138,8 @@ def slab_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float,
         gmsh.model.mesh.setSizeCallback(
             lambda dim, tag, x, y, z, lc: cell_size(x, x_in, dx, s_in))
         gmsh.model.mesh.generate(2)
-        _, coords, _ = gmsh.model.mesh.getNodes()
+        node_tags, coords, _ = gmsh.model.mesh.getNodes()
         tags, _, nodes = gmsh.model.mesh.getElements(dim=2)
-        node_tags = gmsh.model.mesh.getNodes()[0]
     if any(int(t) != 3 for t in tags):
         raise RuntimeError("gmsh left non-quadrilateral elements in the slab")
     index = np.full(int(node_tags.max()) + 1, -1)
@@ -334,6 +340,8 @@ def main(argv: list[str] | None = None) -> int:
             ap.error(f"{name}: {value} (valid range > 0)")
     if not 0.0 <= args.width <= 10.0:
         ap.error(f"--width {args.width}: valid range 0 (the strip) to 10 (a)")
+    if args.aligned and not args.width:
+        ap.error("--aligned: a slab's option, give --width W > 0 (a) with it")
     if not 1.5 <= args.x_in < args.x_out:
         ap.error(f"--x-in {args.x_in}, --x-out {args.x_out}: need 1.5 <= x_in < x_out (a)")
     runtime = FoamRuntime.from_environment()
