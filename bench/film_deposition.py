@@ -148,11 +148,8 @@ def slab_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float,
     quads = index[np.asarray(nodes[0], int).reshape(-1, 4)]
     base = BaseMesh(points, quads)
     quads = np.where((base.quad_areas() < 0)[:, None], quads[:, ::-1], quads)
-    # boundary edges: those of one quad only, kept in their quad's (counter-clockwise) order
-    edges = np.stack([quads, np.roll(quads, -1, axis=1)], axis=2).reshape(-1, 2)
-    key = np.sort(edges, axis=1) @ np.array([len(points), 1])
-    _, first, count = np.unique(key, return_index=True, return_counts=True)
-    outer = edges[first[count == 1]]
+    topo = mesh_module._edge_topology(quads, len(points))   # boundary edges, quad on the left
+    outer = np.stack([topo.bnd_a, topo.bnd_b], axis=1)
     mid = points[outer].mean(axis=1)
     tol = 1e-6 * dx
     names = {"inlet": np.abs(mid[:, 0] - x_in) < tol, "outlet": np.abs(mid[:, 0] - x_out) < tol,
