@@ -138,14 +138,7 @@ def slab_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float,
         gmsh.model.mesh.setSizeCallback(
             lambda dim, tag, x, y, z, lc: cell_size(x, x_in, dx, s_in))
         gmsh.model.mesh.generate(2)
-        node_tags, coords, _ = gmsh.model.mesh.getNodes()
-        tags, _, nodes = gmsh.model.mesh.getElements(dim=2)
-    if any(int(t) != 3 for t in tags):
-        raise RuntimeError("gmsh left non-quadrilateral elements in the slab")
-    index = np.full(int(node_tags.max()) + 1, -1)
-    index[node_tags.astype(int)] = np.arange(len(node_tags))
-    points = np.asarray(coords).reshape(-1, 3)[:, :2]
-    quads = index[np.asarray(nodes[0], int).reshape(-1, 4)]
+        points, quads, _ = mesh_module._extract_mesh({})   # raises on any non-quad
     base = BaseMesh(points, quads)
     quads = np.where((base.quad_areas() < 0)[:, None], quads[:, ::-1], quads)
     topo = mesh_module._edge_topology(quads, len(points))   # boundary edges, quad on the left
