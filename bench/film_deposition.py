@@ -225,11 +225,21 @@ def x_at_gap(gap, h: float, x_lo: float, x_hi: float) -> float:
     return brentq(g, x_lo, x_hi, xtol=1e-12)
 
 
+def lateral_speed(folder: Path, mesh: PolyMesh, x_r: float, a: float, u: float) -> float:
+    """The rms velocity across y over the cells within a of the rear meniscus x_r (m), by
+    volume, over the wall speed u (m/s): the slab's flow should not vary in y at all, so this
+    is its lateral spurious current (0 on the strip, whose sides are empty)."""
+    near = np.abs(mesh.cell_centres[:, 0] - x_r) < a
+    uy = np.asarray(FoamFieldFile(folder / "U").internal_field, float)[near, 1]
+    return float(np.sqrt(np.average(uy**2, weights=mesh.cell_volumes[near]))) / u
+
+
 def measure(case: Path, mesh: PolyMesh, a: float, x_out: float,
-            x_edges: np.ndarray | None = None) -> list[dict]:
+            x_edges: np.ndarray | None = None, u: float | None = None) -> list[dict]:
     """At every write: the rear meniscus x_r/a and the gap there (m), the films behind it (m,
     both walls) and the oil held per metre of width (m2); on a slab, over the bins of x
-    between ``x_edges`` (m)."""
+    between ``x_edges`` (m). Given the wall speed u (m/s), also the lateral current around
+    the rear meniscus over u (:func:`lateral_speed`)."""
     x, h, _ = columns(mesh, np.zeros(len(mesh.cell_volumes)), x_edges)
     rows = []
     for t, folder in case_fields.time_folders(case):
@@ -249,6 +259,8 @@ def measure(case: Path, mesh: PolyMesh, a: float, x_out: float,
                      "deposited_fraction": film / h_r,
                      "oil_per_width_m2": float(np.sum(np.clip(alpha, 0.0, 1.0) * mesh.cell_volumes)
                                                / np.ptp(mesh.points[:, 1]))})
+        if u is not None:
+            rows[-1]["lateral_rms_over_u"] = lateral_speed(folder, mesh, x_r, a, u)
     return rows
 
 
@@ -353,15 +365,17 @@ def main(argv: list[str] | None = None) -> int:
         case = args.work / (f"{level}_dx{dx_a:g}{strip}" + "".join(
             f"_{k.split('.')[-1]}{v}" for k, v in args.set))
         run = run_or_reuse(runtime, spec, case, mesh, x_ll, args, dx_a * a)
-        rows = measure(case, mesh, a, args.x_out * a, x_edges)
+        rows = measure(case, mesh, a, args.x_out * a, x_edges, spec.wall_speed)
         late = [r for r in rows if r["t_s"] >= 0.6 * args.time]
         f = float(np.median([r["deposited_fraction"] for r in late])) if late else float("nan")
+        lateral = float(np.median([r["lateral_rms_over_u"] for r in late])) if late else float("nan")
         h_star = args.film / f
         result = {"level": level, "dx_over_a": dx_a, "dx_m": dx_a * a, "cells": mesh.n_cells,
                   **run,
                   "landau_levich": ll, "x_rear_landau_levich_over_a": x_ll / a,
                   "deposited_fraction_late_median": f,
                   "deposited_over_landau_levich": f / ll,
+                  "lateral_rms_over_u_late_median": lateral,
                   "x_rear_balance_over_a": x_at_gap(gap, h_star, args.x_in * a,
                                                     3 * args.x_out * a) / a,
                   "x_rear_last_over_a": rows[-1]["x_rear_over_a"] if rows else None,
@@ -371,7 +385,8 @@ def main(argv: list[str] | None = None) -> int:
               f"{result['steps']:6d} steps {result['wall_s']:6.0f} s {result['status']}: deposited "
               f"{f * 100:5.2f} % of the gap (LL {ll * 100:4.2f} %, x{f / ll:5.2f}); rear "
               f"{result['x_rear_last_over_a'] or float('nan'):6.2f} a at the end, balance "
-              f"{result['x_rear_balance_over_a']:6.2f} a (LL {x_ll / a:5.2f} a)", flush=True)
+              f"{result['x_rear_balance_over_a']:6.2f} a (LL {x_ll / a:5.2f} a); lateral current "
+              f"{lateral:5.3f} u rms", flush=True)
         save_rows(args, results)   # after every case: an interrupted sweep keeps them
     return 0
 
