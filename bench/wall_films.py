@@ -80,6 +80,13 @@ def films(case: Path) -> dict:
 AXIS_HALF_WIDTH = 0.15
 
 
+def rear_meniscus(x: np.ndarray, y: np.ndarray, mid: np.ndarray) -> float | None:
+    """The rear meniscus on the axis [a]: the furthest column (x, |y| in a) with oil at
+    mid-gap (``mid`` > 0.5) on |y| < AXIS_HALF_WIDTH; None where the axis holds none."""
+    wet = (y < AXIS_HALF_WIDTH) & (mid > 0.5)
+    return float(x[wet].max()) if wet.any() else None
+
+
 def rear_films(case: Path, bins: list[tuple[float, float]] = ((1.0, 2.0),),
                from_transits: float = 0.0) -> dict:
     """Per write of ``case`` from ``from_transits`` on: the rear meniscus on the axis x_r [a],
@@ -98,10 +105,9 @@ def rear_films(case: Path, bins: list[tuple[float, float]] = ((1.0, 2.0),),
             continue
         oil, mid = columns(folder, st, geom.n_layers)
         film = oil / st.footprint
-        wet = axis & (mid > 0.5)
-        if not wet.any():
+        x_r = rear_meniscus(x, y, mid)
+        if x_r is None:
             continue
-        x_r = float(x[wet].max())
         h_r = float(np.median(gap[axis & (np.abs(x - x_r) <= 0.1)]))
         row = {"time_s": t, "transits": t / geom.transit_time, "rear_over_a": x_r,
                "gap_at_rear_m": h_r, "film_over_ll": []}

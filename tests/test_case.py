@@ -20,7 +20,7 @@ from foamlib import FoamFieldFile, FoamFile
 from ehl_precalc.spec import SpecError
 from generator.case_spec import make_case_spec
 from generator.case_writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_time_step,
-                                   load_geometry, mesh_warnings, write_case)
+                                   load_geometry, load_spec_of, mesh_warnings, write_case)
 from runs import case_fields
 from runs.cli import parse_value
 from runs.foam_runtime import FoamRuntime
@@ -1083,3 +1083,43 @@ def test_rear_films_read_a_known_film_behind_a_known_rear_meniscus(small_case, t
     ll = res["landau_levich_both_walls_over_gap"]
     assert w["film_over_ll"][0] * ll * w["gap_at_rear_m"] == pytest.approx(film, rel=1e-9)
     assert w["film_over_ll"][1] is None                # no column 90-99 a behind the rear
+
+
+def test_rear_currents_read_known_lateral_speeds_beside_a_known_rear_meniscus(small_case,
+                                                                               tmp_path):
+    """bench/rear_currents.py on one write by hand: oil wall to wall ahead of x = 2.5 a, air
+    behind; U_y = 0.2 u in the oil and -0.5 u in the air, and 9 u along x that must not count.
+    Beside the rear meniscus the rms speeds across y are those, no cell is interface, and the
+    gap-averaged one is their mix by the footprints of the box's oil and air columns."""
+    from bench.rear_currents import rear_currents
+
+    case = _copy(small_case, tmp_path)
+    geom, spec = load_geometry(case), load_spec_of(case)
+    st = case_fields.Structure.load(case)
+    x = st.base_x[st.base_cell] / geom.a
+    oil = x < 2.5
+    u = spec.wall_speed
+    velocity = np.zeros((len(x), 3))
+    velocity[:, 0] = 9.0 * u
+    velocity[:, 1] = np.where(oil, 0.2, -0.5) * u
+    folder = case / "0.001"
+    folder.mkdir()
+    for name, value in (("alpha.oil", oil.astype(float)), ("U", velocity)):
+        shutil.copy(case / "0.orig" / name, folder / name)
+        FoamFieldFile(folder / name).internal_field = value
+
+    res = rear_currents(case, half_length=1.0, y_from=0.3, y_to=2.0)
+    xb, yb = st.base_x / geom.a, np.abs(st.base_y) / geom.a
+    assert res["rear_over_a"] == pytest.approx(xb[(yb < 0.15) & (xb < 2.5)].max())
+    box = (np.abs(xb - res["rear_over_a"]) < 1.0) & (yb >= 0.3) & (yb < 2.0)
+    wet, dry = st.footprint[box & (xb < 2.5)].sum(), st.footprint[box & (xb >= 2.5)].sum()
+    assert wet > 0 and dry > 0
+    assert res["oil_rms_over_u"] == pytest.approx(0.2, rel=1e-9)
+    assert res["air_rms_over_u"] == pytest.approx(0.5, rel=1e-9)
+    assert res["interface_rms_over_u"] is None
+    assert res["gap_averaged_rms_over_u"] == pytest.approx(
+        np.sqrt((0.04 * wet + 0.25 * dry) / (wet + dry)), rel=1e-9)
+    # a case whose axis holds no oil at mid-gap has no rear meniscus to read around
+    FoamFieldFile(folder / "alpha.oil").internal_field = np.zeros(len(x))
+    with pytest.raises(ValueError, match="no oil at mid-gap"):
+        rear_currents(case)
