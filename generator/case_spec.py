@@ -398,7 +398,9 @@ class Run(BaseModel):
             meniscus at rest keeps its currents at 7.5-8.5 % of u where 3 let them burst to
             42 %, and the rolling case's oil and length move halfway to the values of 1, at
             1.5 times the steps a transit of 3 (1: 3.4 times). docs/cases.md, "The capillary
-            safety".
+            safety". For the films a rear meniscus lays, use 0.5: at 2 a slab's straight rear
+            meniscus grows lateral currents of 0.3-0.9 u, at 0.5 (on 0.045-0.06 a cells)
+            0.002-0.008 u ("Lateral currents").
         air_viscosity_factor: the air's viscosity in the solver is this times
             physics.air_viscosity (not in the gas-release scene: :attr:`CaseSpec.air_viscosity`).
             Spurious capillary currents in the air scale as
