@@ -106,7 +106,7 @@ def test_a_slab_holds_the_gap_between_two_planar_symmetry_planes(strip, free):
 def test_the_lateral_current_is_the_rms_speed_across_y_within_a_of_the_rear_meniscus(strip,
                                                                                       tmp_path):
     """A slab's flow should not vary in y: its speed across y around the rear meniscus is a
-    spurious current (0.46 u rms at the default step on the fine walls, 0.002 u at a quarter
+    spurious current (0.46 u rms at the default step on the fine walls, 0.002 u at half
     of it, docs/cases.md). Read on a field written by hand: 0.3 u across y within a of x_r,
     u elsewhere (which must not count), and a wall speed along x that must not count either."""
     spec, gap, a, _ = strip
