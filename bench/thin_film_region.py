@@ -105,7 +105,8 @@ def _progress(a: float, transit_s: float):
 def save_state(sol: ThinFilmSolution, path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(path, x=sol.grid.x, y=sol.grid.y, h=sol.grid.h, flooded=sol.flooded,
-                        content=sol.content)
+                        content=sol.content, p=sol.p,
+                        fill=np.zeros(sol.flooded.shape) if sol.fill is None else sol.fill)
 
 
 def load_state(path: Path) -> ThinFilmSolution:

@@ -322,3 +322,35 @@ def test_a_saved_state_starts_a_run_where_it_left_off(tmp_path):
     finer = solve_thin_film(ball_problem(cell=0.2 * A), transits_max=0, start=start)
     assert finer.metrics(A)["oil_volume_m3"] == pytest.approx(sol.metrics(A)["oil_volume_m3"],
                                                               rel=0.05)
+
+
+def test_the_lateral_current_beside_the_rear_meniscus_is_read_off_the_pressure(tmp_path):
+    """bench/rear_currents.py on a thin-film state written by hand: a gap of 10 um, the region
+    flooded ahead of x = 8 a, a pressure falling along y at the rate that drives 0.3 u across
+    y (h^2 / (12 eta) dp/dy = -0.3 u). Beside the rear meniscus (x_r = 8 a) the gap-averaged
+    rms is 0.3 u over the flooded cells only, the Poiseuille profile's sqrt(6/5) times that;
+    a state without its pressure is refused by name."""
+    from bench.rear_currents import thin_film_currents
+    from generator.case_spec import make_case_spec
+
+    spec = make_case_spec({})
+    a, u, eta, gap = spec.a, spec.speed, spec.oil_viscosity, 10e-6
+    d = 0.25 * a
+    x = -4 * a + d * (np.arange(80) + 0.5)
+    y = d * (np.arange(24) + 0.5)
+    X, Y = np.meshgrid(x, y)
+    h = np.where(np.hypot(X, Y) < a, np.nan, gap)
+    flooded = (X < 8 * a) & ~np.isnan(h)
+    p = np.where(flooded, 0.3 * u * 12 * eta / gap**2 * (-Y), np.nan)
+    state = tmp_path / "state.npz"
+    np.savez(state, x=x, y=y, h=h, flooded=flooded, content=np.where(flooded, h, 0.0), p=p,
+             fill=np.zeros(h.shape))
+    res = thin_film_currents(state, spec, half_length=1.0, y_from=0.5, y_to=1.5)
+    assert res["rear_over_a"] == pytest.approx(8.0)
+    assert res["cells"] == 4 * 4                    # x in (7, 8) a, y in [0.5, 1.5) a
+    assert res["gap_averaged_rms_over_u"] == pytest.approx(0.3, rel=1e-9)
+    assert res["gap_averaged_median_abs_over_u"] == pytest.approx(0.3, rel=1e-9)
+    assert res["poiseuille_rms_over_u"] == pytest.approx(0.3 * np.sqrt(1.2), rel=1e-9)
+    np.savez(state, x=x, y=y, h=h, flooded=flooded, content=np.where(flooded, h, 0.0))
+    with pytest.raises(ValueError, match="holds no pressure"):
+        thin_film_currents(state, spec)
