@@ -45,8 +45,8 @@ sys.path.insert(0, str(ROOT))
 
 from foamlib import FoamFieldFile  # noqa: E402
 
-from bench.film_deposition import (add_strip_options, measure, run_or_reuse,  # noqa: E402
-                                    save_rows, strip_mesh, sweep)
+from bench.film_deposition import (add_strip_options, measure, options_suffix,  # noqa: E402
+                                   run_or_reuse, save_rows, strip_mesh, sweep)
 from generator.case_spec import CaseSpec  # noqa: E402
 from generator.case_writer import oil_fraction  # noqa: E402
 from generator.mesh import PolyMesh  # noqa: E402
@@ -203,9 +203,9 @@ def main(argv: list[str] | None = None) -> int:
         ca = spec.oil_viscosity * spec.speed / spec.physics.surface_tension
         table = balance(spec, gap, args.x_in * a, args.x_out * a, args.precursor)
         mesh = strip_mesh(spec, gap, args.x_in * a, args.x_out * a, dx_a * a)
-        case = args.work / (f"{level}_dx{dx_a:g}_x{args.x_in:g}-{args.x_out:g}" + "".join(
-            f"_{k.split('.')[-1]}{v}" for k, v in args.set)
-            + (f"_pre{args.precursor:g}" if args.precursor else ""))
+        case = args.work / (f"{level}_dx{dx_a:g}_x{args.x_in:g}-{args.x_out:g}"
+                            + options_suffix(args)
+                            + (f"_pre{args.precursor:g}" if args.precursor else ""))
         run = run_or_reuse(runtime, spec, case, mesh, args.bridge * a, args, dx_a * a,
                            adjust=partial(reverse_walls, mesh=mesh, precursor=args.precursor))
         rows = measure(case, mesh, a, args.x_out * a)

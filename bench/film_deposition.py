@@ -47,7 +47,7 @@ sys.path.insert(0, str(ROOT))
 
 from foamlib import FoamFieldFile  # noqa: E402
 
-from bench.common import save, spec_option  # noqa: E402
+from bench.common import apply_edits, edit_value_text, foam_edit, save, spec_option  # noqa: E402
 from ehl_precalc.meniscus_reynolds import landau_levich  # noqa: E402
 from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
 from generator.case_writer import (TEMPLATES, capillary_time_step,  # noqa: E402
@@ -279,6 +279,7 @@ def run_or_reuse(runtime: FoamRuntime, spec: CaseSpec, case: Path, mesh: PolyMes
                           args.time / args.writes)
     if adjust is not None:
         adjust(spec, case)
+    apply_edits(case, getattr(args, "edit", []))
     t0 = time.perf_counter()
     proc = runtime.run("interFoam", cwd=case, log_path=case / "log.interFoam", check=False)
     run = {"max_delta_t_s": dt, "end_time_s": args.time,
@@ -304,11 +305,17 @@ def save_rows(args: argparse.Namespace, rows: list[dict]) -> None:
                          "rows": rows})
 
 
+def options_suffix(args: argparse.Namespace) -> str:
+    """The part of a strip case's folder name that its --set and --edit options make."""
+    return "".join(f"_{k.split('.')[-1]}{v}" for k, v in args.set) + "".join(
+        f"_{keys[-1]}{edit_value_text(value, '')}" for _, keys, value in args.edit)
+
+
 def add_strip_options(ap: argparse.ArgumentParser, dx: list[float], level: str,
                       time_s: float, writes: int, work: Path) -> None:
     """The options the strip benches share, with their defaults: the cells (--dx, a) and
     levels, the run's length and writes, spec edits, where the cases go, --reuse and the
-    record (--save, --note)."""
+    record (--save, --note), and --edit of the written case's system/ files."""
     ap.add_argument("--dx", nargs="+", type=float, default=dx, help="in-plane cell sizes [a]")
     ap.add_argument("--levels", nargs="+", default=[level],
                     help="levels whose wall layers and capillary safety are used")
@@ -316,6 +323,10 @@ def add_strip_options(ap: argparse.ArgumentParser, dx: list[float], level: str,
     ap.add_argument("--writes", type=int, default=writes, help="writes over the run")
     ap.add_argument("--set", action="append", default=[], type=spec_option,
                     metavar="KEY=VALUE", help="any other spec option (e.g. mesh.n_layers=20)")
+    ap.add_argument("--edit", action="append", default=[], type=foam_edit,
+                    metavar="FILE:KEY/SUBKEY=VALUE",
+                    help="change an entry of a generated system/ file (what the spec does not "
+                         "offer, e.g. fvSchemes:snGradSchemes/default=corrected)")
     ap.add_argument("--work", type=Path, default=work)
     ap.add_argument("--reuse", action="store_true",
                     help="measure a case already run to --time in --work instead of re-running")
@@ -362,8 +373,7 @@ def main(argv: list[str] | None = None) -> int:
         strip = ("" if (args.x_in, args.x_out) == (X_IN, X_OUT)
                  else f"_x{args.x_in:g}-{args.x_out:g}") + (
             f"_w{args.width:g}" + ("_aligned" if args.aligned else "") if args.width else "")
-        case = args.work / (f"{level}_dx{dx_a:g}{strip}" + "".join(
-            f"_{k.split('.')[-1]}{v}" for k, v in args.set))
+        case = args.work / f"{level}_dx{dx_a:g}{strip}{options_suffix(args)}"
         run = run_or_reuse(runtime, spec, case, mesh, x_ll, args, dx_a * a)
         rows = measure(case, mesh, a, args.x_out * a, x_edges, spec.wall_speed)
         late = [r for r in rows if r["t_s"] >= 0.6 * args.time]
@@ -379,7 +389,9 @@ def main(argv: list[str] | None = None) -> int:
                   "x_rear_balance_over_a": x_at_gap(gap, h_star, args.x_in * a,
                                                     3 * args.x_out * a) / a,
                   "x_rear_last_over_a": rows[-1]["x_rear_over_a"] if rows else None,
-                  "options": dict(args.set), "writes": rows}
+                  "options": dict(args.set),
+                  "edits": [f"{file}:{'/'.join(keys)}={edit_value_text(value)}"
+                            for file, keys, value in args.edit], "writes": rows}
         results.append(result)
         print(f"{level:>7} dx {dx_a:5.3g} a ({dx_a * a * 1e6:5.1f} um) {mesh.n_cells:6d} cells "
               f"{result['steps']:6d} steps {result['wall_s']:6.0f} s {result['status']}: deposited "

@@ -127,3 +127,34 @@ def test_the_lateral_current_is_the_rms_speed_across_y_within_a_of_the_rear_meni
     w = mesh.cell_volumes[near]
     expected = np.sqrt(np.sum(w * velocity[near, 1] ** 2) / w.sum()) / u
     assert lateral_speed(tmp_path, mesh, x_r, a, u) == pytest.approx(expected, rel=1e-9)
+
+
+def test_strip_options_edit_the_written_case_and_name_it(strip, tmp_path):
+    """The strip benches' --edit changes the written case's system/ files before it runs (here
+    the interface normal's gradient), --set and --edit name the case's folder, and --reuse
+    takes a finished run instead of running it again."""
+    import argparse
+
+    from bench.film_deposition import add_strip_options, options_suffix, run_or_reuse
+
+    spec, gap, a, mesh = strip
+    ap = argparse.ArgumentParser()
+    add_strip_options(ap, [0.5], "coarse", 0.01, 1, tmp_path)
+    args = ap.parse_args(["--set", "run.capillary_safety=0.5",
+                          "--edit", "fvSchemes:gradSchemes/nHat=pointCellsLeastSquares",
+                          "--edit", "fvSchemes:divSchemes/div(phirb,alpha)=Gauss "
+                                    "interfaceCompression"])
+    args.film = 2e-6
+    assert options_suffix(args) == ("_capillary_safety0.5_nHatpointCellsLeastSquares"
+                                    "_div(phirb,alpha)GaussinterfaceCompression")
+    case = tmp_path / "strip"
+    runtime = FoamRuntime.from_environment()
+    run = run_or_reuse(runtime, spec, case, mesh, 7 * a, args, 0.5 * a)
+    assert run["status"] == "ok" and run["steps"] > 0
+    schemes = FoamFile(case / "system" / "fvSchemes")
+    assert schemes["gradSchemes"]["nHat"] == "pointCellsLeastSquares"
+    assert tuple(schemes["divSchemes"]["div(phirb,alpha)"]) == ("Gauss", "interfaceCompression")
+    (case / "log.interFoam").unlink()
+    args.reuse = True
+    assert run_or_reuse(runtime, spec, case, mesh, 7 * a, args, 0.5 * a) == run
+    assert not (case / "log.interFoam").exists()         # taken, not run again
