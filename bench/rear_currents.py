@@ -32,8 +32,8 @@ from foamlib import FoamFieldFile
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
+from bench.thin_film_region import load_state  # noqa: E402
 from bench.wall_films import rear_meniscus  # noqa: E402
-from ehl_precalc.meniscus_reynolds import Grid, connected_region, region_metrics  # noqa: E402
 from generator.case_spec import CaseSpec, load_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
 from runs import case_fields  # noqa: E402
@@ -84,15 +84,13 @@ def thin_film_currents(state: Path, spec: CaseSpec, half_length: float = 0.5,
     cells where the region's staircase edge turns the flow), and sqrt(6/5) times the rms (the
     rms across the gap of the Poiseuille profile with that mean: the 3D cases' oil figure)."""
     a, u, eta = spec.a, spec.speed, spec.oil_viscosity
-    d = np.load(state)
-    if "p" not in d:
+    sol = load_state(state)
+    if not np.isfinite(sol.p).any():
         raise ValueError(f"{state}: holds no pressure (written before the states kept it); "
                          "run bench/thin_film_region.py again")
-    h, p = d["h"], d["p"]
-    grid = Grid(x=d["x"], y=d["y"], h=h, hx=np.empty((0, 0)), hy=np.empty((0, 0)),
-                h_side=np.empty(0), island=np.isnan(h))
-    region = connected_region(d["flooded"], grid.island)
-    x_r = region_metrics(region, grid, a, 0.0, d["fill"])["rear_meniscus_x_over_a"]
+    grid, h, p = sol.grid, sol.grid.h, sol.p
+    region = sol.region()
+    x_r = sol.metrics(a)["rear_meniscus_x_over_a"]
     if x_r is None:
         raise ValueError(f"{state}: no flooded cell behind the island on the axis")
     # U_y on the y faces between two flooded cells with a pressure (a cell that flooded in
@@ -132,7 +130,8 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--half-length {args.half_length}, --y-from {args.y_from}, --y-to {args.y_to}: "
                  "need L > 0 and 0 <= y_from < y_to (a)")
     box = (args.half_length, args.y_from, args.y_to)
-    rows = [thin_film_currents(c, load_case_spec(args.spec), *box) if c.suffix == ".npz"
+    spec = load_case_spec(args.spec) if any(c.suffix == ".npz" for c in args.cases) else None
+    rows = [thin_film_currents(c, spec, *box) if c.suffix == ".npz"
             else rear_currents(c, *box) for c in args.cases]
     print(f"{'case':56s} {'transits':>8s} {'rear (a)':>8s} | U_y rms / u: oil    air  interface"
           "  gap-averaged")

@@ -111,13 +111,15 @@ def save_state(sol: ThinFilmSolution, path: Path) -> None:
 
 def load_state(path: Path) -> ThinFilmSolution:
     """A state written by ``save_state``, enough of it to start a run from (its grid's cells,
-    gaps and oil)."""
+    gaps and oil) and to read its flow: its pressure (NaN throughout in a state written before
+    states kept it) and its menisci's fills (None there)."""
     d = np.load(path)
     grid = Grid(x=d["x"], y=d["y"], h=d["h"], hx=np.empty((0, 0)), hy=np.empty((0, 0)),
                 h_side=np.empty(0), island=np.isnan(d["h"]))
-    return ThinFilmSolution(grid=grid, p=np.full(d["h"].shape, np.nan), content=d["content"],
-                            flooded=d["flooded"], time=0.0, steps=0, flux_in=0.0,
-                            flux_out=0.0, steady=False, island_radius=0.0)
+    return ThinFilmSolution(grid=grid, p=d["p"] if "p" in d else np.full(d["h"].shape, np.nan),
+                            content=d["content"], flooded=d["flooded"], time=0.0, steps=0,
+                            flux_in=0.0, flux_out=0.0, steady=False, island_radius=0.0,
+                            fill=d["fill"] if "fill" in d else None)
 
 
 def plot_menisci(records: list[dict], a: float, out: Path) -> None:
