@@ -3,7 +3,8 @@ state per resolution level, with the flow-pattern metrics each level gives.
 
     python bench/case_bench.py [--levels coarse medium fine] [--speed 0.008]
         [--supply layers --layer 2e-6 --track 3e-4] [--jobs 2] [--wall-limit 3600]
-        [--sequence] [--start-from LEVEL|CASE] [--procs N] [--set KEY=VALUE ...] [--collect]
+        [--sequence] [--start-from LEVEL|CASE|STATE.npz] [--procs N] [--set KEY=VALUE ...]
+        [--collect]
 
 Each level runs serially (one core; ``--procs`` ranks with mpirun); ``--jobs`` runs levels side
 by side. ``--sequence`` runs the levels one after the other, each starting from the previous
@@ -28,7 +29,7 @@ sys.path.insert(0, str(ROOT))
 from generator.case_spec import make_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, write_case  # noqa: E402
 from common import apply_edits, foam_edit, solver_cpu_s, spec_option  # noqa: E402
-from runs.ramp import seed_from_previous  # noqa: E402
+from runs.ramp import seed_case  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
 RESULTS = ROOT / "bench" / "results"
@@ -54,7 +55,7 @@ def one(level: str, args: argparse.Namespace, previous: str | None = None) -> di
     write_case(spec, case, overwrite=True)
     apply_edits(case, args.edit)
     if previous is not None:
-        seed_from_previous(case, case.parent / previous)
+        seed_case(case, case.parent / previous)
     build_s = time.perf_counter() - t0
     run_case(case)
     return row_of(case, level, previous, build_s)
@@ -63,8 +64,9 @@ def one(level: str, args: argparse.Namespace, previous: str | None = None) -> di
 def start_case(folder: Path, given: str) -> str:
     """What ``--start-from`` names, as :func:`one` joins it to the tag's ``folder``: a level
     already run there (a sibling case) if there is one of that name, else the path ``given``
-    (relative to the working directory) of any finished case, made absolute."""
-    if (folder / given).is_dir() or not Path(given).is_dir():
+    (relative to the working directory) of any finished case or thin-film state (.npz),
+    made absolute."""
+    if (folder / given).is_dir() or not Path(given).exists():
         return given
     return str(Path(given).resolve())
 
@@ -91,10 +93,11 @@ def main(argv=None) -> int:
     ap.add_argument("--sequence", action="store_true",
                     help="each level starts from the previous level's final fields")
     ap.add_argument("--procs", type=int, default=1, help="MPI ranks per case")
-    ap.add_argument("--start-from", default=None, metavar="LEVEL|CASE",
+    ap.add_argument("--start-from", default=None, metavar="LEVEL|CASE|STATE.npz",
                     help="the first level starts from the final fields of LEVEL, already run "
                          "under --tag (grid sequencing without re-running LEVEL), or of the "
-                         "finished case at the path CASE (another tag, another mesh)")
+                         "finished case at the path CASE (another tag, another mesh), or "
+                         "the oil of the thin-film state CASE.npz")
     ap.add_argument("--collect", action="store_true",
                     help="only tabulate the levels already run under --tag")
     ap.add_argument("--set", action="append", default=[], type=spec_option, metavar="KEY=VALUE",

@@ -32,7 +32,7 @@ from foamlib import FoamFieldFile
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
-from bench.thin_film_region import load_state  # noqa: E402
+from ehl_precalc.thin_film_state import load_state  # noqa: E402
 from bench.wall_films import rear_meniscus  # noqa: E402
 from generator.case_spec import CaseSpec, load_case_spec  # noqa: E402
 from generator.case_writer import load_geometry, load_spec_of  # noqa: E402

@@ -32,8 +32,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save, spec_option  # noqa: E402
-from ehl_precalc.meniscus_reynolds import (Grid, ThinFilmProblem,  # noqa: E402
-                                           ThinFilmSolution, solve_thin_film)
+from ehl_precalc.meniscus_reynolds import ThinFilmProblem, solve_thin_film  # noqa: E402
+from ehl_precalc.thin_film_state import load_state, save_state  # noqa: E402
 from generator.case_spec import CaseSpec, load_case_spec  # noqa: E402
 from generator.gap_source import load_gap  # noqa: E402
 
@@ -100,26 +100,6 @@ def _progress(a: float, transit_s: float):
               f"{rec['cells_opened_dry']} cells ran dry",
               file=sys.stderr, flush=True)
     return show
-
-
-def save_state(sol: ThinFilmSolution, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(path, x=sol.grid.x, y=sol.grid.y, h=sol.grid.h, flooded=sol.flooded,
-                        content=sol.content, p=sol.p,
-                        fill=np.zeros(sol.flooded.shape) if sol.fill is None else sol.fill)
-
-
-def load_state(path: Path) -> ThinFilmSolution:
-    """A state written by ``save_state``, enough of it to start a run from (its grid's cells,
-    gaps and oil) and to read its flow: its pressure (NaN throughout in a state written before
-    states kept it) and its menisci's fills (None there)."""
-    d = np.load(path)
-    grid = Grid(x=d["x"], y=d["y"], h=d["h"], hx=np.empty((0, 0)), hy=np.empty((0, 0)),
-                h_side=np.empty(0), island=np.isnan(d["h"]))
-    return ThinFilmSolution(grid=grid, p=d["p"] if "p" in d else np.full(d["h"].shape, np.nan),
-                            content=d["content"], flooded=d["flooded"], time=0.0, steps=0,
-                            flux_in=0.0, flux_out=0.0, steady=False, island_radius=0.0,
-                            fill=d["fill"] if "fill" in d else None)
 
 
 def plot_menisci(records: list[dict], a: float, out: Path) -> None:

@@ -254,6 +254,24 @@ class ThinFilmSolution:
         """The flooded cells connected to the island: the flooded region, bool (ny, nx)."""
         return connected_region(self.flooded, self.grid.island)
 
+    def oil_fraction_at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """The oil over the gap, c / h (0-1), of the cell holding each point (x, y) [m]:
+        1 in the flooded cells, the films' share behind the menisci, in the island that of the
+        nearest cell outside it (a 3D mesh's cells at the island's rim may lie in an island
+        cell of this grid); NaN off the grid (beyond its x range or y_max). The grid is a half
+        domain: y is taken as |y|."""
+        h = self.grid.h
+        frac = np.where(h > 0, self.content / np.where(h > 0, h, 1.0), 0.0)
+        frac = np.where(self.flooded, 1.0, np.clip(frac, 0.0, 1.0))
+        nearest = ndimage.distance_transform_edt(self.grid.island, return_distances=False,
+                                                 return_indices=True)
+        frac = frac[tuple(nearest)]
+        x, y = np.broadcast_arrays(np.asarray(x, float), np.abs(np.asarray(y, float)))
+        d = self.grid.cell
+        off = ((x < self.grid.x[0] - d / 2) | (x > self.grid.x[-1] + d / 2)
+               | (y > self.grid.y[-1] + d / 2))
+        return np.where(off, np.nan, _nearest_cell(self.grid, frac, x, y))
+
     def metrics(self, a: float) -> dict:
         """The flow-pattern metrics of the CFD cases (runs/metrics.py), in units of a."""
         return region_metrics(self.region(), self.grid, a, self.island_radius, self.fill) | {
@@ -660,16 +678,22 @@ def _touches(flooded: np.ndarray) -> np.ndarray:
     return t & ~flooded
 
 
-def _interpolate(sol: ThinFilmSolution, grid: Grid) -> np.ndarray:
-    """The oil fraction c / h of ``sol`` at the cells of ``grid`` (nearest cell)."""
+def _nearest_cell(grid: Grid, values: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``values`` (ny, nx) of ``grid``'s cell nearest each point (x, y) [m] (the edge cells'
+    beyond the grid)."""
     from scipy.interpolate import RegularGridInterpolator
 
+    f = RegularGridInterpolator((grid.y, grid.x), values, method="nearest")
+    pts = np.column_stack([np.clip(np.ravel(y), grid.y[0], grid.y[-1]),
+                           np.clip(np.ravel(x), grid.x[0], grid.x[-1])])
+    return f(pts).reshape(np.shape(x))
+
+
+def _interpolate(sol: ThinFilmSolution, grid: Grid) -> np.ndarray:
+    """The oil fraction c / h of ``sol`` at the cells of ``grid`` (nearest cell)."""
     frac = np.where(sol.grid.h > 0, sol.content / np.where(sol.grid.h > 0, sol.grid.h, 1), 0.0)
-    frac = np.nan_to_num(frac)
-    f = RegularGridInterpolator((sol.grid.y, sol.grid.x), frac, method="nearest",
-                                bounds_error=False, fill_value=0.0)
     X, Y = np.meshgrid(grid.x, grid.y)
-    return np.where(grid.island, 0.0, f(np.column_stack([Y.ravel(), X.ravel()])).reshape(X.shape))
+    return np.where(grid.island, 0.0, _nearest_cell(sol.grid, np.nan_to_num(frac), X, Y))
 
 
 def _gap(gap, X, Y, solid) -> np.ndarray:

@@ -61,10 +61,10 @@ def cmd_case(args: argparse.Namespace) -> int:
         print(f"ehlfoam case: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.start_from:
-        from runs.ramp import RampError, final_time
+        from runs.ramp import RampError, check_start
 
         try:   # before anything is written
-            final_time(args.start_from)
+            check_start(args.start_from)
         except (RampError, OSError) as err:   # missing, or not a folder
             print(f"ehlfoam case: --start-from {args.start_from}: {err}", file=sys.stderr)
             return EXIT_BAD_INPUT
@@ -74,11 +74,13 @@ def cmd_case(args: argparse.Namespace) -> int:
         print(f"ehlfoam case: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.start_from:
-        from runs.ramp import seed_from_previous
+        from runs.ramp import seed_case
 
-        seed = seed_from_previous(args.out, args.start_from)
-        print(f"starts from {args.start_from} at t = {seed['previous_time_s']:.4g} s "
-              f"({seed['method']}: {', '.join(seed['fields'])})")
+        seed = seed_case(args.out, args.start_from)
+        at = ("" if seed["previous_time_s"] is None
+              else f" at t = {seed['previous_time_s']:.4g} s")
+        print(f"starts from {args.start_from}{at} ({seed['method']}: "
+              f"{', '.join(seed['fields'])})")
     print(f"case {args.out}: {geom.solver}, {geom.cells} cells, a = {geom.a * 1e3:.4f} mm, "
           f"transit {geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, "
           f"maxDeltaT {geom.max_delta_t:.3g} s ({geom.capillary_limit}), "
@@ -191,10 +193,11 @@ def build_parser() -> argparse.ArgumentParser:
                            "--set mesh.resolution=coarse; none clears an optional key, e.g. "
                            "--set mesh.polar_radius=none (repeatable)")
     case.add_argument("--overwrite", action="store_true", help="replace an existing case")
-    case.add_argument("--start-from", default=None, metavar="CASE",
+    case.add_argument("--start-from", default=None, metavar="CASE|STATE.npz",
                       help="start from the final fields of another run case (a converged "
                            "neighbour: another speed, supply or level), copied on the same "
-                           "mesh, else interpolated")
+                           "mesh, else interpolated; or from the oil of a thin-film state "
+                           "(bench/thin_film_region.py writes them)")
     case.set_defaults(func=cmd_case)
 
     run = sub.add_parser(

@@ -42,12 +42,8 @@ class LayeredMesh:
     @classmethod
     def load(cls, case: str | Path) -> "LayeredMesh":
         s = Structure.load(case)
-        base, layer = s.base_cell, s.layer
-        v = np.zeros((len(s.base_x), int(layer.max()) + 1))
-        v[base, layer] = s.cell_volumes
-        below = np.cumsum(v, axis=1) - 0.5 * v
-        zeta_bl = below / v.sum(axis=1, keepdims=True)
-        return cls(base, layer, zeta_bl[base, layer], np.stack([s.base_x, s.base_y], axis=1))
+        lo, hi = relative_heights(s)
+        return cls(s.base_cell, s.layer, 0.5 * (lo + hi), np.stack([s.base_x, s.base_y], axis=1))
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -63,6 +59,17 @@ class LayeredMesh:
     def layer_zeta(self) -> np.ndarray:
         """The mean relative height of each layer."""
         return np.bincount(self.layer, self.zeta) / np.bincount(self.layer)
+
+
+def relative_heights(s: Structure) -> tuple[np.ndarray, np.ndarray]:
+    """Each cell's bottom and top across the gap, as the volume fraction of its column below
+    them (0 on the disc, 1 on the ball), (C,) each."""
+    base, layer = s.base_cell, s.layer
+    v = np.zeros((len(s.base_x), int(layer.max()) + 1))
+    v[base, layer] = s.cell_volumes
+    top = np.cumsum(v, axis=1) / v.sum(axis=1, keepdims=True)
+    hi = top[base, layer]
+    return hi - s.cell_volumes / v.sum(axis=1)[base], hi
 
 
 def interpolate(values: np.ndarray, source: LayeredMesh, target: LayeredMesh) -> np.ndarray:

@@ -130,3 +130,33 @@ def seed_from_previous(case: str | Path, previous: str | Path) -> dict[str, Any]
             "fields": names, "cells": load_geometry(case).cells}
     atomic_write_json(case / META / "ramp.json", info)
     return info
+
+
+def is_thin_film_state(source: str | Path) -> bool:
+    """True when ``source`` names a thin-film state (``.npz``) rather than a run case."""
+    return Path(source).suffix == ".npz"
+
+
+def check_start(source: str | Path) -> None:
+    """Raise :class:`RampError` (or OSError) unless ``source`` can start a case: a run case
+    with a written time, or a readable thin-film state. Call it before writing anything."""
+    if not is_thin_film_state(source):
+        final_time(source)
+        return
+    from ehl_precalc.thin_film_state import load_state
+
+    try:
+        load_state(source)
+    except (OSError, KeyError, ValueError) as err:
+        raise RampError(f"{source} is not a thin-film state written by "
+                        f"bench/thin_film_region.py ({err})") from None
+
+
+def seed_case(case: str | Path, source: str | Path) -> dict[str, Any]:
+    """Start ``case`` from ``source``: a run case's final fields (:func:`seed_from_previous`)
+    or a thin-film state's oil (:func:`runs.thin_film_seed.seed_from_thin_film`)."""
+    if is_thin_film_state(source):
+        from .thin_film_seed import seed_from_thin_film
+
+        return seed_from_thin_film(case, source)
+    return seed_from_previous(case, source)

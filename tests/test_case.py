@@ -707,6 +707,65 @@ def test_cli_case_starts_from_another_run_case(tmp_path):
         start, case_fields._read_alpha(first / "0.orig" / "alpha.oil", structure)[0])
 
 
+def _thin_film_state(path: Path, a: float, films: float) -> None:
+    """A thin-film state written by hand on 0.25 a cells over x = -2..4 a, y = 0..2 a of a
+    gap of 20 um: flooded ahead of x = a, films of ``films`` of the gap behind."""
+    from ehl_precalc.meniscus_reynolds import Grid, ThinFilmSolution
+    from ehl_precalc.thin_film_state import save_state
+
+    d = 0.25 * a
+    x, y = -2 * a + d * (np.arange(24) + 0.5), d * (np.arange(8) + 0.5)
+    X, _ = np.meshgrid(x, y)
+    h = np.full(X.shape, 20e-6)
+    flooded = X < a
+    grid = Grid(x=x, y=y, h=h, hx=h[:, 1:], hy=h[1:], h_side=h[-1],
+                island=np.zeros(X.shape, bool))
+    save_state(ThinFilmSolution(grid=grid, p=np.where(flooded, 0.0, np.nan),
+                                content=np.where(flooded, h, films * h), flooded=flooded,
+                                time=0.0, steps=0, flux_in=0.0, flux_out=0.0, steady=False,
+                                island_radius=0.0), path)
+
+
+def test_cli_case_starts_from_a_thin_film_state(small_case, tmp_path):
+    """`ehlfoam case --start-from STATE.npz`: each column on the state's grid starts with the
+    state's oil, whole where it is flooded, and behind as two films on the walls holding the
+    state's share of the gap; columns off its grid keep the spec's own start. A file that is
+    no state is refused before anything is written."""
+    spec = tmp_path / "small.toml"
+    spec.write_text(_toml(SMALL))
+    a = load_geometry(small_case).a
+    state, bad, case = tmp_path / "state.npz", tmp_path / "bad.npz", tmp_path / "seeded"
+    _thin_film_state(state, a, films=0.2)
+    bad.write_text("not a state")
+    refused = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(case),
+                              "--start-from", str(bad)], capture_output=True, text=True)
+    assert refused.returncode == 2 and "not a thin-film state" in refused.stderr
+    assert not case.exists()
+    proc = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(case), "--start-from",
+                           str(state)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "starts from" in proc.stdout and "thin-film" in proc.stdout
+    info = json.loads((case / "ehlfoam" / "ramp.json").read_text())
+    assert info["method"] == "thin-film" and info["fields"] == ["alpha.oil"]
+    s = case_fields.Structure.load(case)
+    alpha = case_fields._read_alpha(case / "0.orig" / "alpha.oil", s)[0]
+    own = case_fields._read_alpha(small_case / "0.orig" / "alpha.oil", s)[0]
+    column_oil = s.gap_mean(alpha)
+    x, y, m = s.base_x / a, s.base_y / a, 0.3          # m: clear of the state's cells' edges
+    ahead = (x > -2 + m) & (x < 1 - m) & (y < 2 - m)
+    behind = (x > 1 + m) & (x < 4 - m) & (y < 2 - m)
+    off = (x > 4 + m) | (y > 2 + m)
+    assert ahead.sum() > 5 and behind.sum() > 5 and off.sum() > 5
+    assert np.all(alpha[np.isin(s.base_cell, np.nonzero(ahead)[0])] == 1.0)
+    np.testing.assert_allclose(column_oil[behind], 0.2, rtol=1e-9)
+    wall = np.isin(s.base_cell, np.nonzero(behind)[0]) & np.isin(s.layer, [0, s.layer.max()])
+    middle = np.isin(s.base_cell, np.nonzero(behind)[0]) & ~np.isin(s.layer, [0, s.layer.max()])
+    assert np.all(alpha[wall] > 0.0) and np.all(alpha[middle] == 0.0)
+    cells_off = np.isin(s.base_cell, np.nonzero(off)[0])
+    np.testing.assert_array_equal(alpha[cells_off], own[cells_off])
+    assert not np.array_equal(alpha, own)
+
+
 def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path):
     """Thinner wall cells under the same in-plane cells make the ball stair-step over many
     wall-cell heights per cell, where a spurious film creeps along it: `ehlfoam case` says so

@@ -8,8 +8,8 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from ehl_precalc.meniscus_reynolds import (Grid, ThinFilmProblem, landau_levich,
-                                           region_metrics, solve_thin_film)
+from ehl_precalc.meniscus_reynolds import (Grid, ThinFilmProblem, ThinFilmSolution,
+                                           landau_levich, region_metrics, solve_thin_film)
 
 ETA, U, SIGMA, THETA = 0.02, 0.01, 0.03, 15.0
 
@@ -311,7 +311,7 @@ def test_a_case_spec_becomes_the_same_problem():
 def test_a_saved_state_starts_a_run_where_it_left_off(tmp_path):
     """bench/thin_film_region.py --start: a state written by a run, read back, starts the
     next one with the same oil in the same cells, on its grid or a finer one."""
-    from bench.thin_film_region import load_state, save_state
+    from ehl_precalc.thin_film_state import load_state, save_state
 
     sol = solve_thin_film(ball_problem(), transits_max=2, tolerance=0.0, transit_length=10 * A)
     save_state(sol, tmp_path / "state.npz")
@@ -354,3 +354,23 @@ def test_the_lateral_current_beside_the_rear_meniscus_is_read_off_the_pressure(t
     np.savez(state, x=x, y=y, h=h, flooded=flooded, content=np.where(flooded, h, 0.0))
     with pytest.raises(ValueError, match="holds no pressure"):
         thin_film_currents(state, spec)
+
+
+def test_oil_fraction_at_reads_the_cell_holding_a_point_on_either_side_of_the_axis():
+    """ThinFilmSolution.oil_fraction_at, what a 3D case starts from: 1 in flooded cells,
+    c / h behind, the same at -y as at y (the model's half domain), the nearest open cell's
+    inside the island, NaN beyond the grid's edges."""
+    d = 1.0
+    x, y = d * (np.arange(6) + 0.5), d * (np.arange(3) + 0.5)
+    X, Y = np.meshgrid(x, y)
+    island = (X < 1) & (Y < 1)
+    h = np.where(island, np.nan, 2.0)
+    flooded = (X < 3) & ~island
+    sol = ThinFilmSolution(
+        grid=Grid(x=x, y=y, h=h, hx=h[:, 1:], hy=h[1:], h_side=h[-1], island=island),
+        p=np.zeros(h.shape), content=np.where(flooded, 2.0, 0.5), flooded=flooded, time=0.0,
+        steps=0, flux_in=0.0, flux_out=0.0, steady=False, island_radius=1.0)
+    got = sol.oil_fraction_at(np.array([2.2, 4.6, 4.6, 0.3, 6.4, 2.0]),
+                              np.array([0.4, 1.2, -1.2, 0.2, 1.0, 3.4]))
+    np.testing.assert_allclose(got[:4], [1.0, 0.25, 0.25, 1.0])
+    assert np.isnan(got[4]) and np.isnan(got[5])
