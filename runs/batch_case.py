@@ -96,7 +96,7 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
     from generator.gap_source import precalc_dir
     from runs.run_case import CaseBusy, run_case
 
-    from .ramp import seed_from_previous
+    from .ramp import seed_case, seed_from_previous
 
     pc = plan_index(batch_dir)[case_id]
     case = batch_dir / CASES / case_id
@@ -124,9 +124,9 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
                     raise RuntimeError(f"the previous ramp step {previous.name} is not "
                                        f"finished ({case_status(previous)})")
                 seed = seed_from_previous(case, previous)
-            elif pc.ramp and pc.ramp.get("start_from"):   # the first step, from a run case
+            elif pc.ramp and pc.ramp.get("start_from"):   # the first step: a case or state
                 stage = "ramp start"
-                seed = seed_from_previous(case, pc.ramp["start_from"])
+                seed = seed_case(case, pc.ramp["start_from"])
             build_s = time.monotonic() - t0
             stage = "run"
             metrics = run_case(case)

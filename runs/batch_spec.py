@@ -31,7 +31,8 @@ cases under ``runs/NAME/``)::
     load_N = 20
     resolution = "coarse"
     start_from = "runs/u8"             # optional: the first step starts from this run
-                                       # case's final fields (a converged state)
+                                       # case's final fields (a converged state), or from
+                                       # the oil of a thin-film state (a .npz file)
 
 A dimension not swept takes the base's value. Units: mm/s, um, N and C in this file only;
 everything inside is SI. Every expanded case is validated by the case spec itself
@@ -254,7 +255,8 @@ class Ramp(BaseModel):
         temperature_C, load_N, supply, resolution: single values (default: the base's).
         start_from: a run case folder (absolute, or relative to where the batch is started)
             whose final fields the first step starts from: a converged state to step the
-            speed up from, instead of the standard start (the puddle).
+            speed up from, instead of the standard start (the puddle); or a thin-film state
+            (.npz, ``bench/thin_film_region.py``) whose oil it starts from.
     """
 
     model_config = _STRICT
@@ -456,14 +458,14 @@ def _check_values(batch: BatchSpec, base: CaseSpec) -> None:
         if r.supply is not None:
             checks.append((f"{where} supply = {r.supply.label!r}", r.supply.overrides()))
     for r in (r for r in batch.ramp if r.start_from):
-        from .ramp import RampError, final_time   # what the step will start from
+        from .ramp import RampError, check_start   # what the step will start from
 
         try:
-            final_time(r.start_from)
+            check_start(r.start_from)
         except (RampError, OSError):
             raise SpecError(f"invalid batch spec: ramp {r.name!r} start_from = "
                             f"{r.start_from!r}: not a case folder with a written time "
-                            f"(give a case that has run)") from None
+                            f"(give a case that has run) nor a thin-film state (.npz)") from None
     for where, overrides in checks:
         try:
             _case_spec(batch.base, "check", overrides)

@@ -10,7 +10,7 @@ in the half domain y >= 0. A run continued from that write (``--start-from``) on
 bands then has its whole meniscus in the band's cells, as long as the meniscus stays within the
 band.
 
-    ehlfoam band CASE --size 0.06 --half-width 1.0 [--time last] [--spacing 0.25]
+    ehlfoam band CASE --size 0.06 --half-width 1.0 [--time last|start|T] [--spacing 0.25]
         [--min-length 1.0]
 
 prints the bands as TOML inline tables, ready for ``--set 'mesh.refine=[...]'`` or a spec's
@@ -34,12 +34,17 @@ from . import case_fields, metrics
 def meniscus_lines(case: str | Path, at: str = "last",
                    threshold: float = 0.5) -> tuple[float, list[np.ndarray]]:
     """(time [s], lines): the ``alpha = threshold`` lines of the mid-gap oil fraction at the
-    write nearest ``at`` transits ("last": the last write), each a (k, 2) array of (x, y) in
-    units of a, cut to y >= 0 (the half domain: a full domain's lines below y = 0 are the
-    mirror of those above, within its asymmetry). Raises ValueError without such a write."""
+    write nearest ``at`` transits ("last": the last write; "start": the case's initial
+    field, ``0.orig/``, e.g. the oil of the thin-film state it starts from), each a (k, 2)
+    array of (x, y) in units of a, cut to y >= 0 (the half domain: a full domain's lines
+    below y = 0 are the mirror of those above, within its asymmetry). Raises ValueError
+    without such a write."""
     geom = load_geometry(case)
     st = case_fields.Structure.load(case)
-    time, folder = case_fields.write_near(case, at, geom.transit_time)
+    if at == "start":
+        time, folder = 0.0, Path(case) / "0.orig"
+    else:
+        time, folder = case_fields.write_near(case, at, geom.transit_time)
     alpha = case_fields.mid_gap_alpha(folder, st, geom)
     r = metrics.raster(st.base_x, st.base_y, alpha, case_fields.pattern_geometry(geom))
     lines = []
@@ -103,7 +108,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--size", type=float, required=True, help="cell size in the band [a]")
     p.add_argument("--half-width", type=float, required=True,
                    help="the band reaches this far either side of the meniscus [a]")
-    p.add_argument("--time", default="last", help="transits of the write to read, or 'last'")
+    p.add_argument("--time", default="last",
+                   help="transits of the write to read, 'last', or 'start' (the initial field: "
+                        "a case started from a thin-film state has its meniscus there)")
     p.add_argument("--spacing", type=float, default=None,
                    help="distance between the band's points [a] (default half-width / 4)")
     p.add_argument("--min-length", type=float, default=None,

@@ -764,6 +764,12 @@ def test_cli_case_starts_from_a_thin_film_state(small_case, tmp_path):
     cells_off = np.isin(s.base_cell, np.nonzero(off)[0])
     np.testing.assert_array_equal(alpha[cells_off], own[cells_off])
     assert not np.array_equal(alpha, own)
+    band = subprocess.run(EHLFOAM + ["band", str(case), "--time", "start", "--size", "0.1",
+                                     "--half-width", "0.5"], capture_output=True, text=True)
+    assert band.returncode == 0, band.stderr
+    pts = np.concatenate([np.array(b["points"]) for b in parse_value(band.stdout)])
+    near_axis = pts[(pts[:, 1] < 1.5) & (pts[:, 0] > 0)]   # the state's rear, x = a to y = 2 a
+    assert len(near_axis) >= 3 and np.abs(near_axis[:, 0] - 1.0).max() < 0.3
 
 
 def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path):
