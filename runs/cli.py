@@ -15,6 +15,7 @@ Exit codes: 0 ok, 1 failure, 2 bad input.
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 from collections.abc import Sequence
 
@@ -74,9 +75,14 @@ def cmd_case(args: argparse.Namespace) -> int:
         print(f"ehlfoam case: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     if args.start_from:
-        from runs.ramp import seed_case
+        from runs.ramp import RampError, seed_case
 
-        seed = seed_case(args.out, args.start_from)
+        try:
+            seed = seed_case(args.out, args.start_from)
+        except RampError as err:   # found only on the new mesh: leave no half-made case
+            shutil.rmtree(args.out, ignore_errors=True)
+            print(f"ehlfoam case: --start-from {args.start_from}: {err}", file=sys.stderr)
+            return EXIT_BAD_INPUT
         at = ("" if seed["previous_time_s"] is None
               else f" at t = {seed['previous_time_s']:.4g} s")
         print(f"starts from {args.start_from}{at} ({seed['method']}: "

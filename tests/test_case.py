@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -707,19 +708,21 @@ def test_cli_case_starts_from_another_run_case(tmp_path):
         start, case_fields._read_alpha(first / "0.orig" / "alpha.oil", structure)[0])
 
 
-def _thin_film_state(path: Path, a: float, films: float) -> None:
-    """A thin-film state written by hand on 0.25 a cells over x = -2..4 a, y = 0..2 a of a
-    gap of 20 um: flooded ahead of x = a, films of ``films`` of the gap behind."""
+def _thin_film_state(path: Path, a: float, films: float, gap_factor: float = 1.0) -> None:
+    """A thin-film state written by hand on 0.25 a cells over x = -2..4 a, y = 0..2 a of the
+    small case's gap (times ``gap_factor``): flooded ahead of x = a, films of ``films`` of the
+    gap behind."""
     from ehl_precalc.meniscus_reynolds import Grid, ThinFilmSolution
     from ehl_precalc.thin_film_state import save_state
+    from generator.gap_source import load_gap
 
     d = 0.25 * a
     x, y = -2 * a + d * (np.arange(24) + 0.5), d * (np.arange(8) + 0.5)
-    X, _ = np.meshgrid(x, y)
-    h = np.full(X.shape, 20e-6)
+    X, Y = np.meshgrid(x, y)
+    gap, _ = load_gap(make_case_spec(SMALL).contact)
+    h = gap_factor * gap(X.ravel(), Y.ravel()).reshape(X.shape)
     flooded = X < a
-    grid = Grid(x=x, y=y, h=h, hx=h[:, 1:], hy=h[1:], h_side=h[-1],
-                island=np.zeros(X.shape, bool))
+    grid = Grid(x=x, y=y, h=h, hx=h[:, 1:], hy=h[1:], h_side=h[-1], island=np.isnan(h))
     save_state(ThinFilmSolution(grid=grid, p=np.where(flooded, 0.0, np.nan),
                                 content=np.where(flooded, h, films * h), flooded=flooded,
                                 time=0.0, steps=0, flux_in=0.0, flux_out=0.0, steady=False,
@@ -729,17 +732,25 @@ def _thin_film_state(path: Path, a: float, films: float) -> None:
 def test_cli_case_starts_from_a_thin_film_state(small_case, tmp_path):
     """`ehlfoam case --start-from STATE.npz`: each column on the state's grid starts with the
     state's oil, whole where it is flooded, and behind as two films on the walls holding the
-    state's share of the gap; columns off its grid keep the spec's own start. A file that is
-    no state is refused before anything is written."""
+    state's share of the gap; columns off its grid keep the spec's own start, and `ehlfoam
+    band --time start` finds the state's meniscus. A file that is no state, or a state of
+    another contact (other gaps), is refused and leaves no case."""
     spec = tmp_path / "small.toml"
     spec.write_text(_toml(SMALL))
     a = load_geometry(small_case).a
-    state, bad, case = tmp_path / "state.npz", tmp_path / "bad.npz", tmp_path / "seeded"
+    state, bad, other, case = (tmp_path / n for n in ("state.npz", "bad.npz", "other.npz",
+                                                      "seeded"))
     _thin_film_state(state, a, films=0.2)
+    _thin_film_state(other, a, films=0.2, gap_factor=1.5)   # another contact's
     bad.write_text("not a state")
     refused = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(case),
                               "--start-from", str(bad)], capture_output=True, text=True)
     assert refused.returncode == 2 and "not a thin-film state" in refused.stderr
+    assert not case.exists()
+    refused = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(case),
+                              "--start-from", str(other)], capture_output=True, text=True)
+    found = re.search(r"its gaps differ from the case's by ([\d.]+)%", refused.stderr)
+    assert refused.returncode == 2 and found and 40 < float(found[1]) < 55   # 1.5 times
     assert not case.exists()
     proc = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(case), "--start-from",
                            str(state)], capture_output=True, text=True)
