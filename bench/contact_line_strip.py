@@ -48,7 +48,7 @@ from foamlib import FoamFieldFile  # noqa: E402
 from bench.film_deposition import (add_strip_options, measure, options_suffix,  # noqa: E402
                                    run_or_reuse, save_rows, strip_mesh, sweep)
 from generator.case_spec import CaseSpec  # noqa: E402
-from generator.case_writer import oil_fraction  # noqa: E402
+from generator.case_writer import wall_layers_fraction  # noqa: E402
 from generator.mesh import PolyMesh  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
 
@@ -71,10 +71,7 @@ def reverse_walls(spec: CaseSpec, case: Path, mesh: PolyMesh | None = None,
         f.boundary_field["supply"] = {"type": "inletOutlet", "inletValue": 1.0, "value": 1.0}
         if precursor > 0:
             z = mesh.points[mesh.faces[mesh.patch_slice("outlet")], 2]
-            layers = spec.supply.model_copy(update={"mode": "layers", "disc_layer": precursor,
-                                                    "ball_layer": precursor})
-            frac = oil_fraction(spec.model_copy(update={"supply": layers}), z.min(1), z.max(1),
-                                z.max(), 1.0)
+            frac = wall_layers_fraction(z.min(1), z.max(1), z.max(), precursor, precursor)
             f.boundary_field["outlet"] = {"type": "inletOutlet", "inletValue": frac,
                                           "value": frac}
     shutil.rmtree(case / "0")

@@ -165,14 +165,21 @@ def oil_fraction(spec: CaseSpec, z_lo, z_hi, gap_h, on_track) -> np.ndarray:
     the supply layers on the disc and the ball ("layers") or the whole height ("flooded"),
     times ``on_track`` (bool, or the fraction of the face on the track)."""
     s = spec.supply
-    span = np.maximum(z_hi - z_lo, 1e-300)
     if s.mode == "flooded":
-        frac = np.ones_like(span)
+        frac = np.ones_like(np.asarray(z_hi - z_lo, dtype=float))
     else:
-        disc = _overlap(z_lo, z_hi, 0.0, np.minimum(s.disc_layer, gap_h))
-        ball = _overlap(z_lo, z_hi, np.maximum(gap_h - s.ball_layer, s.disc_layer), gap_h)
-        frac = (disc + ball) / span
-    return np.clip(frac, 0.0, 1.0) * np.asarray(on_track, dtype=float)
+        frac = wall_layers_fraction(z_lo, z_hi, gap_h, s.disc_layer, s.ball_layer)
+    return frac * np.asarray(on_track, dtype=float)
+
+
+def wall_layers_fraction(z_lo, z_hi, gap_h, disc_layer, ball_layer) -> np.ndarray:
+    """Oil fraction (0-1) of cells or faces spanning z in [z_lo, z_hi] of a column of gap
+    gap_h, holding an oil layer of ``disc_layer`` on the disc (z = 0) and one of
+    ``ball_layer`` on the ball (z = gap_h); any one length unit, arrays broadcast."""
+    span = np.maximum(z_hi - z_lo, 1e-300)
+    disc = _overlap(z_lo, z_hi, 0.0, np.minimum(disc_layer, gap_h))
+    ball = _overlap(z_lo, z_hi, np.maximum(gap_h - ball_layer, disc_layer), gap_h)
+    return np.clip((disc + ball) / span, 0.0, 1.0)
 
 
 def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:

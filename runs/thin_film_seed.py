@@ -23,21 +23,11 @@ from foamlib import FoamFieldFile
 from ehl_precalc.outputs import atomic_write_json
 from ehl_precalc.meniscus_reynolds import ThinFilmSolution
 from ehl_precalc.thin_film_state import load_state
-from generator.case_writer import META, load_geometry
+from generator.case_writer import META, load_geometry, wall_layers_fraction
 
 from .case_fields import Structure
 from .field_mapping import relative_heights
 from .ramp import RampError
-
-
-def wall_films_alpha(column_oil: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """alpha.oil of cells spanning ``lo``-``hi`` across the gap (fractions, 0 on the disc) in
-    columns holding ``column_oil`` of their gap as oil, laid as two equal films, one on each
-    wall (a full column: 1 throughout)."""
-    half = 0.5 * np.clip(column_oil, 0.0, 1.0)
-    disc = np.clip(np.minimum(hi, half) - lo, 0.0, None)
-    ball = np.clip(hi - np.maximum(lo, 1.0 - half), 0.0, None)
-    return np.clip((disc + ball) / (hi - lo), 0.0, 1.0)
 
 
 #: The largest median difference between a thin-film state's gaps and a case's, relative to
@@ -88,7 +78,8 @@ def seed_from_thin_film(case: str | Path, state: str | Path) -> dict[str, Any]:
     path = case / "0.orig" / "alpha.oil"
     own = np.broadcast_to(np.asarray(FoamFieldFile(path).internal_field, float),
                           s.cell_volumes.shape)
-    alpha = np.where(np.isnan(phi), own, wall_films_alpha(np.nan_to_num(phi), lo, hi))
+    half = 0.5 * np.nan_to_num(phi)     # two equal films, in fractions of the gap
+    alpha = np.where(np.isnan(phi), own, wall_layers_fraction(lo, hi, 1.0, half, half))
     with FoamFieldFile(path) as f:
         f.internal_field = alpha
     if (case / "0").exists():   # a stale start folder would shadow 0.orig
