@@ -122,12 +122,19 @@ def seed_from_previous(case: str | Path, previous: str | Path) -> dict[str, Any]
         fields, method = _copied_fields(folder, names), "copy"
     else:
         fields, method = _mapped_fields(case, previous, folder, names), "interpolated"
+    return write_seed(case, fields, {"previous": os.path.relpath(previous, case),
+                                     "previous_time_s": t, "method": method, "fields": names})
+
+
+def write_seed(case: Path, fields: dict[str, Any], info: dict[str, Any]) -> dict[str, Any]:
+    """Write ``fields`` (name -> internal values) as ``case``'s initial fields (``0.orig/``),
+    drop a stale ``0/`` that would shadow them, and record ``info`` and the case's cell count
+    in ``ehlfoam/ramp.json``; returns that record."""
     for name, value in fields.items():
         _write_internal(case / "0.orig" / name, value)
     if (case / "0").exists():      # a stale start folder would shadow 0.orig
         shutil.rmtree(case / "0")
-    info = {"previous": os.path.relpath(previous, case), "previous_time_s": t, "method": method,
-            "fields": names, "cells": load_geometry(case).cells}
+    info = {**info, "cells": load_geometry(case).cells}
     atomic_write_json(case / META / "ramp.json", info)
     return info
 

@@ -13,21 +13,19 @@ a few steps in this Stokes flow.
 from __future__ import annotations
 
 import os
-import shutil
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from foamlib import FoamFieldFile
 
-from ehl_precalc.outputs import atomic_write_json
 from ehl_precalc.meniscus_reynolds import ThinFilmSolution
 from ehl_precalc.thin_film_state import load_state
-from generator.case_writer import META, load_geometry, wall_layers_fraction
+from generator.case_writer import wall_layers_fraction
 
 from .case_fields import Structure
 from .field_mapping import relative_heights
-from .ramp import RampError
+from .ramp import RampError, write_seed
 
 
 #: The largest median difference between a thin-film state's gaps and a case's, relative to
@@ -80,12 +78,6 @@ def seed_from_thin_film(case: str | Path, state: str | Path) -> dict[str, Any]:
                           s.cell_volumes.shape)
     half = 0.5 * np.nan_to_num(phi)     # two equal films, in fractions of the gap
     alpha = np.where(np.isnan(phi), own, wall_layers_fraction(lo, hi, 1.0, half, half))
-    with FoamFieldFile(path) as f:
-        f.internal_field = alpha
-    if (case / "0").exists():   # a stale start folder would shadow 0.orig
-        shutil.rmtree(case / "0")
-    info = {"previous": os.path.relpath(state, case), "previous_time_s": None,
-            "method": "thin-film", "fields": ["alpha.oil"], "cells": load_geometry(case).cells,
-            "columns_seeded": float(np.mean(~np.isnan(column)))}
-    atomic_write_json(case / META / "ramp.json", info)
-    return info
+    return write_seed(case, {"alpha.oil": alpha}, {
+        "previous": os.path.relpath(state, case), "previous_time_s": None, "method": "thin-film",
+        "fields": ["alpha.oil"], "columns_seeded": float(np.mean(~np.isnan(column)))})
