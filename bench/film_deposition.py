@@ -51,10 +51,10 @@ from bench.common import apply_edits, edit_value_text, foam_edit, save, spec_opt
 from ehl_precalc.meniscus_reynolds import landau_levich  # noqa: E402
 from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
 from generator.case_writer import (TEMPLATES, capillary_time_step,  # noqa: E402
-                                   edit_physics_dicts, edit_run_control)
+                                   edit_physics_dicts, edit_run_control, extrude_level)
 from generator.gap_source import load_gap  # noqa: E402
 from generator import mesh as mesh_module  # noqa: E402
-from generator.mesh import BaseMesh, PolyMesh, extrude, split_patch, write_polymesh  # noqa: E402
+from generator.mesh import BaseMesh, PolyMesh, split_patch, write_polymesh  # noqa: E402
 from runs import case_fields  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
 
@@ -102,9 +102,8 @@ def strip_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float) -> Pol
     edges = {"inlet": np.array([[n + 1, 0]]), "outlet": np.array([[n, 2 * n + 1]]),
              "side": np.concatenate([np.stack([i, i + 1], 1),
                                      np.stack([n + 2 + i, n + 1 + i], 1)])}
-    level = spec.mesh.level()
-    mesh = extrude(BaseMesh(points, quads, edges), lambda xs, ys: gap(xs, np.zeros_like(xs)),
-                   level["n_layers"], level["wall_grading"], spec.mesh.columns)
+    mesh = extrude_level(spec, BaseMesh(points, quads, edges),
+                         lambda xs, ys: gap(xs, np.zeros_like(xs)))
     mesh = split_patch(mesh, "inlet", np.ones(mesh.patch("inlet").size, bool), "supply")
     mesh.patches = [replace(p, type="empty") if p.name == "side" else p for p in mesh.patches]
     return mesh
@@ -147,10 +146,8 @@ def slab_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float,
     tol = 1e-6 * dx
     names = {"inlet": np.abs(mid[:, 0] - x_in) < tol, "outlet": np.abs(mid[:, 0] - x_out) < tol,
              "symmetry": np.abs(mid[:, 1]) < tol, "side": np.abs(mid[:, 1] - width) < tol}
-    level = spec.mesh.level()
-    mesh = extrude(BaseMesh(points, quads, {k: outer[v] for k, v in names.items()}),
-                   lambda xs, ys: gap(xs, np.zeros_like(xs)),
-                   level["n_layers"], level["wall_grading"], spec.mesh.columns)
+    mesh = extrude_level(spec, BaseMesh(points, quads, {k: outer[v] for k, v in names.items()}),
+                         lambda xs, ys: gap(xs, np.zeros_like(xs)))
     mesh = split_patch(mesh, "inlet", np.ones(mesh.patch("inlet").size, bool), "supply")
     mesh.patches = [replace(p, type="symmetryPlane") if p.name == "side" else p
                     for p in mesh.patches]

@@ -41,7 +41,6 @@ from bench.common import save  # noqa: E402
 from bench.oil_change import columns  # noqa: E402
 from ehl_precalc.meniscus_reynolds import landau_levich  # noqa: E402
 from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
-from generator.mesh import layer_fractions  # noqa: E402
 from runs import case_fields  # noqa: E402
 
 #: where the films are read, in units of a: (name, x > ..., |y| < ..., |y| > ...)
@@ -61,15 +60,17 @@ def films(case: Path) -> dict:
         sel = st.layer == layer
         wall[name] = np.bincount(st.base_cell[sel], alpha[sel], minlength=n)
     x, y = st.base_x / geom.a, np.abs(st.base_y) / geom.a
+    wall_share = st.wall_cell / (np.bincount(st.base_cell, st.cell_volumes, minlength=n)
+                                 / st.footprint)       # the wall cell over the column's gap
     out = {"case": str(case), "cells": geom.cells,
-           "wall_cell_over_gap": float(np.diff(layer_fractions(
-               geom.n_layers, spec.mesh.level()["wall_grading"]))[0]),
+           "wall_cell_over_gap": float(np.median(wall_share)),
            "landau_levich_both_walls_over_gap": landau_levich(
                spec.oil_viscosity, spec.speed, spec.physics.surface_tension)}
     for name, x_min, y_max, y_min in REGIONS:
         sel = (mid < 0.05) & (x > x_min) & (y < y_max) & (y > y_min)
         out[name] = ({"columns": int(sel.sum()),
                       "oil_over_gap_median": float(np.median(oil[sel])),
+                      "wall_cell_over_gap_median": float(np.median(wall_share[sel])),
                       "disc_wall_cell_alpha_median": float(np.median(wall["disc"][sel])),
                       "ball_wall_cell_alpha_median": float(np.median(wall["ball"][sel]))}
                      if sel.any() else None)

@@ -324,6 +324,12 @@ class Mesh(BaseModel):
             depends on it (docs/cases.md, "The far field decides the width").
         wall_grading: mid-gap cell height over wall cell height (1: uniform layers); finer
             cells at the walls carry the supply layers and the films left behind.
+        wall_cell: instead of wall_grading, one wall cell height [m] everywhere: each column
+            of cells graded just enough for it (uniform where the gap is too thin, graded
+            at most 100). A share of the gap that falls as the gap grows: thin where the
+            rear meniscus lays its films in a wide gap, thick near the contact, where the
+            region's front runs onto dry walls and in-plane cells within some 15 wall cells
+            hold it (docs/cases.md, "One wall cell everywhere"). None by default.
         polar_radius: outer radius, units of a, of a structured polar ring of cells around
             the island (log-polar, near-square cells, the size growing with the radius as
             everywhere); "auto" (the default): :data:`POLAR_RING_SHARE` x the nearest
@@ -350,6 +356,7 @@ class Mesh(BaseModel):
     size_rim: float | None = Field(None, gt=0.0, le=10.0)
     size_far: float | None = Field(None, gt=0.0, le=50.0)
     wall_grading: float | None = Field(None, ge=1.0, le=100.0)
+    wall_cell: float | None = Field(None, ge=1e-8, le=1e-4)
     polar_radius: float | Literal["auto"] | None = "auto"
     columns: Literal["normal", "vertical"] = "normal"
     refine: tuple[Refinement, ...] = ()
@@ -365,6 +372,14 @@ class Mesh(BaseModel):
                              f'({POLAR_RING_SHARE:g} x the nearest boundary) or none (free '
                              'quads)')
         return float(value)
+
+    @model_validator(mode="after")
+    def _one_wall_rule(self) -> "Mesh":
+        if self.wall_cell is not None and self.wall_grading is not None:
+            raise ValueError(f"set one of wall_grading ({self.wall_grading:g}) and wall_cell "
+                             f"({self.wall_cell:g} m): the wall cell fixes each column's "
+                             f"grading")
+        return self
 
     def level(self) -> dict[str, float]:
         """The level's sizes with the overrides applied."""

@@ -26,8 +26,8 @@ from runs.foam_runtime import FoamRuntime
 
 from .case_spec import CaseSpec
 from .gap_source import load_gap
-from .mesh import (MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
-                   layer_fractions, split_patch, wall_steps, write_polymesh)
+from .mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
+                   split_patch, wall_steps, write_polymesh)
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
 META = "ehlfoam"  # the case's own folder of generator outputs
@@ -182,6 +182,14 @@ def wall_layers_fraction(z_lo, z_hi, gap_h, disc_layer, ball_layer) -> np.ndarra
     return np.clip((disc + ball) / span, 0.0, 1.0)
 
 
+def extrude_level(spec: CaseSpec, base: BaseMesh, gap) -> PolyMesh:
+    """``base`` extruded across ``gap(x, y)`` [m] in the spec's layers: the level's count and
+    wall grading, or one wall cell height everywhere (``mesh.wall_cell``)."""
+    level = spec.mesh.level()
+    return extrude(base, gap, level["n_layers"], level["wall_grading"], spec.mesh.columns,
+                   wall_cell=spec.mesh.wall_cell)
+
+
 def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     """alpha.oil at t = 0: the supply layers on the track, a puddle of radius
     initial_puddle a around the contact (whole gap height) and a gas seed of radius
@@ -190,13 +198,10 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
     if spec.scene == "single-phase":
         return np.ones(len(mesh.cell_volumes))
     x, y = mesh.cell_centres[:, 0], mesh.cell_centres[:, 1]
-    level = spec.mesh.level()
-    f = layer_fractions(level["n_layers"], level["wall_grading"])
     h = gap(x, y)
-    k = mesh.layer
     on_track = ((np.abs(y) < spec.supply.track_half_width)
                 & (np.abs(y) >= spec.supply.track_inner_half_width))
-    alpha = oil_fraction(spec, h * f[k], h * f[k + 1], h, on_track)
+    alpha = oil_fraction(spec, h * mesh.spans[:, 0], h * mesh.spans[:, 1], h, on_track)
     puddle = spec.fills_domain | (np.hypot(x, y) < spec.supply.initial_puddle * spec.a)
     alpha = np.where(puddle, 1.0, alpha)
     rim = spec.domain.island_radius * spec.a
@@ -510,7 +515,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
                         polar_radius=None if spec.polar_radius is None
                         else spec.polar_radius * a)
     base = build_base_mesh(params, size_function(spec))
-    mesh = extrude(base, gap, level["n_layers"], level["wall_grading"], spec.mesh.columns)
+    mesh = extrude_level(spec, base, gap)
     steps = float(np.median(wall_steps(base, mesh)))
     mesh, supply = with_supply_patch(spec, mesh)
     dx = smallest_cell_size(spec)

@@ -641,7 +641,9 @@ class PolyMesh:
     first in upper-triangular order. ``face_centres``/``face_areas``
     (F, 3) and ``cell_centres`` (C, 3)/``cell_volumes`` (C,) are computed as
     OpenFOAM does (m, m^2, m^3). ``base_cell`` is the 2D quad of each cell,
-    ``layer`` its layer (0 at the disc).
+    ``layer`` its layer (0 at the disc); ``spans`` (C, 2) the bottom and top of each
+    cell across its column as fractions of the gap (0 on the disc, 1 on the ball: the mean
+    of its nodes' levels, :func:`extrude`).
     """
 
     points: np.ndarray
@@ -655,6 +657,7 @@ class PolyMesh:
     layer: np.ndarray
     face_centres: np.ndarray
     face_areas: np.ndarray
+    spans: np.ndarray
 
     @property
     def n_cells(self) -> int:
@@ -815,6 +818,31 @@ def _cell_geometry(n_cells: int, owner: np.ndarray, neighbour: np.ndarray,
     return ctr, vol3 / 3.0
 
 
+def _tanh_levels(s: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """Level fractions 0 .. 1 at uniform ``s`` (L + 1,) of the tanh stretching of strength
+    ``beta`` (shape (...,)): shape (..., L + 1); beta -> 0 is uniform."""
+    beta = np.maximum(np.asarray(beta, float), 1e-6)[..., None]
+    f = 0.5 * (1 + np.tanh(beta * (2 * s - 1)) / np.tanh(beta))
+    f[..., 0], f[..., -1] = 0.0, 1.0
+    return f
+
+
+def _stretching(n_layers: int, wall_grading: float) -> float:
+    """The tanh stretching strength whose mid-gap cell is ``wall_grading`` times the wall
+    cell (bisection: the ratio grows with the strength)."""
+    s = np.arange(n_layers + 1) / n_layers
+
+    def ratio(beta: float) -> float:
+        d = np.diff(_tanh_levels(s, beta))
+        return d[len(d) // 2] / d[0]
+
+    lo, hi = 1e-6, 20.0
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ratio(mid) < wall_grading else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 def layer_fractions(n_layers: int, wall_grading: float = 1.0) -> np.ndarray:
     """Level heights as fractions of the gap, 0 .. 1 (n_layers + 1 values), symmetric about
     mid-gap; ``wall_grading`` is the ratio of the middle cell's height to the wall cell's
@@ -823,20 +851,28 @@ def layer_fractions(n_layers: int, wall_grading: float = 1.0) -> np.ndarray:
     s = np.arange(n_layers + 1) / n_layers
     if not wall_grading > 1.0 or n_layers < 3:
         return s
+    return _tanh_levels(s, _stretching(n_layers, wall_grading))
 
-    def ratio(beta: float) -> float:
-        f = 0.5 * (1 + np.tanh(beta * (2 * s - 1)) / np.tanh(beta))
-        d = np.diff(f)
-        return d[len(d) // 2] / d[0]
 
-    lo, hi = 1e-6, 20.0
-    for _ in range(100):          # bisection: ratio grows with beta
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ratio(mid) < wall_grading else (lo, mid)
-    beta = 0.5 * (lo + hi)
-    f = 0.5 * (1 + np.tanh(beta * (2 * s - 1)) / np.tanh(beta))
-    f[0], f[-1] = 0.0, 1.0
-    return f
+def column_fractions(h: np.ndarray, n_layers: int, wall_cell: float,
+                     max_grading: float = 100.0) -> np.ndarray:
+    """Level fractions (n, n_layers + 1) for columns of gap ``h`` (n,) [m] whose wall cells
+    are ``wall_cell`` [m] high: each column graded (tanh, as :func:`layer_fractions`) just
+    enough for it, uniform where h / n_layers is that thin already, and graded
+    ``max_grading`` where even that leaves the wall cell thicker. One wall cell height
+    everywhere puts thin cells (a small share of the gap) where the gap is wide, at the rear
+    meniscus whose films they must hold, and thick ones near the contact, where the dry walls
+    run into the region's front and in-plane cells within some 15 wall cells suffice
+    (docs/cases.md, "One wall cell everywhere")."""
+    h = np.asarray(h, float)
+    s = np.arange(n_layers + 1) / n_layers
+    if n_layers < 3:
+        return np.broadcast_to(s, (len(h), n_layers + 1)).copy()
+    beta_max = _stretching(n_layers, max_grading)
+    table = np.linspace(0.0, beta_max, 400)
+    wall = _tanh_levels(s, table)[:, 1]                       # falls as beta grows
+    beta = np.interp(wall_cell / h, wall[::-1], table[::-1])  # clamps at both ends
+    return _tanh_levels(s, beta)
 
 
 #: How the columns of nodes run across the gap (:func:`extrude`).
@@ -871,13 +907,16 @@ def _column_tilt(base: BaseMesh, gap: GapFunction, h: np.ndarray) -> np.ndarray:
 
 
 def extrude(base: BaseMesh, gap: GapFunction, n_layers: int,
-            wall_grading: float = 1.0, columns: str = "normal") -> PolyMesh:
+            wall_grading: float = 1.0, columns: str = "normal",
+            wall_cell: float | None = None) -> PolyMesh:
     """Extrude ``base`` across the gap into ``n_layers`` layers of hexahedra.
 
     ``gap(x, y)`` is the local gap height h (m) at arrays of points (m); it
     must be > 0 and finite at every base node. Level ``k`` of node ``i`` lies
     on the surface z = f_k h(x, y): disc at z = 0, ball at z = h, with
-    f_k = k / n_layers or graded toward both walls (:func:`layer_fractions`).
+    f_k = k / n_layers or graded toward both walls (:func:`layer_fractions`), or with
+    ``wall_cell`` [m] graded column by column so that every wall cell is that high where the
+    gap allows (:func:`column_fractions`; ``wall_grading`` is then unused).
 
     ``columns = "vertical"``: the node sits at ``(x_i, y_i, h_i * f_k)``.
     ``columns = "normal"`` (default): the column leans so that it crosses every level at
@@ -903,16 +942,19 @@ def extrude(base: BaseMesh, gap: GapFunction, n_layers: int,
         raise ValueError(f"wall_grading must be in [1, 100], got {wall_grading!r}")
     if columns not in COLUMNS:
         raise ValueError(f"columns must be one of {COLUMNS}, got {columns!r}")
-    frac = layer_fractions(L, wall_grading)
+    if wall_cell is not None and not (np.isfinite(wall_cell) and wall_cell > 0.0):
+        raise ValueError(f"wall_cell must be a height > 0 (m), got {wall_cell!r}")
+    frac = (column_fractions(h, L, wall_cell) if wall_cell is not None
+            else np.broadcast_to(layer_fractions(L, wall_grading), (len(h), L + 1)))
     points = np.empty((len(points2), L + 1, 3))
     points[..., :2] = points2[:, None, :]
     points[..., 2] = h[:, None] * frac
     if columns == "normal":
         tilt = _column_tilt(base, gap, h)
-        points[:, 1:, :2] += frac[None, 1:, None] ** 2 * tilt[:, None, :]   # f = 1: the ball
+        points[:, 1:, :2] += frac[:, 1:, None] ** 2 * tilt[:, None, :]   # f = 1: the ball
         inner = points[:, 1:, :2].reshape(-1, 2)
         points[:, 1:, 2] = (np.asarray(gap(inner[:, 0], inner[:, 1]), float)
-                            .reshape(len(points2), L) * frac[None, 1:])
+                            .reshape(len(points2), L) * frac[:, 1:])
     points = points.reshape(-1, 3)
 
     topo = _edge_topology(quads, len(points2))
@@ -932,9 +974,12 @@ def extrude(base: BaseMesh, gap: GapFunction, n_layers: int,
     fc, sf = _face_geometry(points, faces_a)
     cc, vol = _cell_geometry(n_cells, owner, nei_int, fc, sf)
     cells = np.arange(n_cells)
+    quad_frac = frac[quads].mean(axis=1)                      # (quads, L + 1)
+    spans = np.stack([quad_frac[:, :-1], quad_frac[:, 1:]], axis=2).reshape(n_cells, 2)
     return PolyMesh(points=points, faces=faces_a, owner=owner, neighbour=nei_int,
                     patches=patches, cell_centres=cc, cell_volumes=vol,
-                    base_cell=cells // L, layer=cells % L, face_centres=fc, face_areas=sf)
+                    base_cell=cells // L, layer=cells % L, face_centres=fc, face_areas=sf,
+                    spans=spans)
 
 
 def wall_steps(base: BaseMesh, mesh: PolyMesh) -> np.ndarray:
@@ -978,7 +1023,8 @@ def split_patch(mesh: PolyMesh, name: str, select: np.ndarray, new_name: str,
     return PolyMesh(points=mesh.points, faces=mesh.faces[perm], owner=mesh.owner[perm],
                     neighbour=mesh.neighbour, patches=patches, cell_centres=mesh.cell_centres,
                     cell_volumes=mesh.cell_volumes, base_cell=mesh.base_cell, layer=mesh.layer,
-                    face_centres=mesh.face_centres[perm], face_areas=mesh.face_areas[perm])
+                    face_centres=mesh.face_centres[perm], face_areas=mesh.face_areas[perm],
+                    spans=mesh.spans)
 
 
 def gap_mismatch(mesh: PolyMesh, gap: GapFunction) -> float:

@@ -6,11 +6,11 @@ across the gap is its relative height zeta in [0, 1], the volume fraction of its
 its centre (exact for a prism column, and the columns here are prisms to within the slope of
 the ball). A value is carried over in two steps:
 
-1. across the gap: in every source column, linear in zeta onto the target's layer heights
-   (the mean zeta of each target layer; the grading is the same in every column, to 4e-4
-   in zeta where the columns lean along the levels' normals, ``mesh.columns = "normal"``);
-2. in plane: linear over a Delaunay triangulation of the source column centres, nearest column
-   outside their hull.
+1. in plane: each source column's values and its layers' heights zeta, linear over a
+   Delaunay triangulation of the source column centres (nearest column outside their hull);
+2. across the gap: in each target column, linear in zeta between the two layers of that
+   interpolated source column around each target cell (clamped at the walls), so that
+   columns graded differently (``mesh.wall_cell``) map as well as evenly graded ones.
 
 OpenFOAM's ``mapFields -consistent`` did this job before; on these meshes it crashes
 (segmentation fault while interpolating, coarse to fine level of a cavitating case), and a
@@ -76,17 +76,27 @@ def interpolate(values: np.ndarray, source: LayeredMesh, target: LayeredMesh) ->
     """Cell values of ``source`` (C_s,) or (C_s, k) interpolated to the cells of ``target``."""
     values = np.asarray(values, dtype=float)
     flat = values.reshape(len(values), -1)
-    cols = source.columns(flat)                               # (B_s, L_s, k)
-    z_s, z_t = source.layer_zeta(), target.layer_zeta()
-    # across the gap: the same weights in every column (the grading is the same everywhere)
-    w = np.stack([np.interp(z_t, z_s, np.eye(len(z_s))[j]) for j in range(len(z_s))], axis=1)
-    across = np.einsum("tj,bjk->btk", w, cols)                # (B_s, L_t, k)
-    flat_cols = across.reshape(len(across), -1)
-    inside = LinearNDInterpolator(source.base_xy, flat_cols)(target.base_xy)
-    outside = np.isnan(inside).any(axis=1)
+    n_s, l_s = source.shape
+    k = flat.shape[1]
+    # in plane: each source column's values and its layers' heights at the target columns
+    cols = source.columns(flat).reshape(n_s, l_s * k)
+    zeta_s = source.columns(source.zeta[:, None])[..., 0]          # (B_s, L_s)
+    stacked = np.concatenate([cols, zeta_s], axis=1)
+    at = LinearNDInterpolator(source.base_xy, stacked)(target.base_xy)
+    outside = np.isnan(at).any(axis=1)
     if outside.any():
-        inside[outside] = NearestNDInterpolator(source.base_xy, flat_cols)(
-            target.base_xy[outside])
-    on_target = inside.reshape(len(target.base_xy), len(z_t), -1)
-    out = on_target[target.base_cell, target.layer]
+        at[outside] = NearestNDInterpolator(source.base_xy, stacked)(target.base_xy[outside])
+    v = at[:, :l_s * k].reshape(len(at), l_s, k)
+    b, zt = target.base_cell, target.zeta
+    if l_s == 1:
+        out = v[b, 0]
+    else:
+        # across the gap: linear in zeta between the two source layers around each target
+        # cell, in its own column (the grading may differ from column to column)
+        zs = at[:, l_s * k:][b]                                     # (C_t, L_s)
+        i = np.clip((zs <= zt[:, None]).sum(axis=1) - 1, 0, l_s - 2)
+        rows = np.arange(len(zt))
+        z0, z1 = zs[rows, i], zs[rows, i + 1]
+        w = np.clip((zt - z0) / np.maximum(z1 - z0, 1e-300), 0.0, 1.0)[:, None]
+        out = (1.0 - w) * v[b, i] + w * v[b, i + 1]
     return out.reshape((len(out),) + values.shape[1:])

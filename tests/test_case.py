@@ -66,6 +66,10 @@ def _copy(case: Path, tmp_path: Path) -> Path:
     ("scene = \"gas-release\"\n[physics]\ngas_dissolution_rate = 100.0\n",
      "physics.gas_dissolution_rate = 100 1/s", 'supply.mode = "submerged"'),
     ("[supply]\nmode = \"bath\"\n", "supply.mode = 'bath'", "'submerged'"),
+    ("[mesh]\nwall_cell = 1e-3\n", "mesh.wall_cell = 0.001",
+     "valid range 1e-08 <= mesh.wall_cell <= 0.0001"),
+    ("[mesh]\nwall_cell = 1e-6\nwall_grading = 20.0\n", "wall_grading (20) and wall_cell (1e-06 m)",
+     "set one of"),
 ])
 def test_bad_spec_fails_before_anything_is_written(tmp_path, table, text, expected):
     spec = tmp_path / "bad.toml"

@@ -16,7 +16,7 @@ from tiny import SMALL
 #: columns stand upright (every column graded alike); where they lean along the levels'
 #: normals (the default) a layer's relative height varies by 4e-4 from column to column,
 #: which moved the field below by 6.4e-4 at most (measured 2026-11-24).
-LINEAR_TOLERANCE = {"vertical": 1e-9, "normal": 2e-3}
+LINEAR_TOLERANCE = {"vertical": 1e-9, "normal": 2e-3, "wall_cell": 2e-3}
 
 
 @pytest.fixture(scope="module", params=sorted(LINEAR_TOLERANCE))
@@ -25,10 +25,14 @@ def meshes(request, tmp_path_factory):
     node columns of ``request.param``."""
     root = tmp_path_factory.mktemp(f"mapping_{request.param}")
     coarse, fine = root / "coarse", root / "fine"
-    mesh = {**SMALL["mesh"], "columns": request.param}
+    if request.param == "wall_cell":   # one wall cell height: each column graded its own way
+        mesh = {k: v for k, v in SMALL["mesh"].items() if k != "wall_grading"} | {
+            "wall_cell": 2e-6}
+    else:
+        mesh = {**SMALL["mesh"], "columns": request.param}
     write_case(make_case_spec({**SMALL, "mesh": mesh}), coarse)
     write_case(make_case_spec({**SMALL, "mesh": {**mesh, "size_rim": 0.18, "n_layers": 5}}), fine)
-    return coarse, fine, LINEAR_TOLERANCE[request.param]
+    return coarse, fine, LINEAR_TOLERANCE[request.param], request.param
 
 
 def test_relative_heights_span_the_gap(meshes):
@@ -39,6 +43,11 @@ def test_relative_heights_span_the_gap(meshes):
     assert np.all(np.diff(z) > 0) and z[0] < 0.2 and z[-1] > 0.8
     # graded symmetrically toward both walls
     assert z[0] == pytest.approx(1 - z[-1], abs=1e-3)
+    wall = m.columns(m.zeta[:, None])[:, 0, 0]              # each column's first layer
+    if meshes[3] == "wall_cell":      # graded more where the gap is wider, uniform at the rim
+        assert wall.min() < 0.5 * wall.max() and wall.max() == pytest.approx(0.1, rel=0.02)
+    else:
+        assert np.ptp(wall) < 2e-3
 
 
 def test_a_linear_field_is_carried_over_exactly_inside_the_source(meshes):
@@ -54,8 +63,8 @@ def test_a_linear_field_is_carried_over_exactly_inside_the_source(meshes):
     want = field(dst)
     # exact where the target cell lies between source layer centres across the gap and
     # inside the hull of the source columns in plane (outside: nearest column)
-    z_s = src.layer_zeta()
-    inner = (dst.zeta >= z_s[0]) & (dst.zeta <= z_s[-1])
+    z_s = src.columns(src.zeta[:, None])[..., 0]          # (columns, layers)
+    inner = (dst.zeta >= z_s[:, 0].max()) & (dst.zeta <= z_s[:, -1].min())
     in_hull = Delaunay(src.base_xy).find_simplex(dst.base_xy[dst.base_cell]) >= 0
     interior = inner & in_hull
     assert interior.sum() > 0.5 * len(dst.zeta)

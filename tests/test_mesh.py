@@ -589,3 +589,40 @@ def test_split_patch_keeps_a_valid_mesh():
     assert np.array_equal(out.faces[:sl.start], mesh.faces[:sl.start])
     with pytest.raises(ValueError, match="one entry per face"):
         split_patch(mesh, "inlet", select[:-1], "supply")
+
+
+def test_one_wall_cell_height_grades_each_column_just_enough(coarse_base):
+    """``wall_cell``: the wall cell is that height wherever the gap allows it (graded between
+    uniform and 100), uniform where the gap is too thin for it, graded 100 where even that
+    leaves it thicker; each cell's span across its column is what its nodes make."""
+    from generator.mesh import column_fractions, layer_fractions
+
+    n = 10
+    h = np.array([5e-6, 2e-5, 1e-4, 2e-4, 1e-2])
+    frac = column_fractions(h, n, 1e-6)
+    wall = frac[:, 1] * h
+    np.testing.assert_allclose(frac[0], np.arange(n + 1) / n)          # h / n = 0.5 um: uniform
+    np.testing.assert_allclose(wall[1:4], 1e-6, rtol=2e-3)             # graded to 1 um
+    assert np.all(np.diff(frac, axis=1) > 0) and np.all(frac[:, [0, -1]] == [0.0, 1.0])
+    np.testing.assert_allclose(frac[:, ::-1], 1 - frac, atol=1e-12)    # symmetric about mid-gap
+    np.testing.assert_allclose(frac[4], layer_fractions(n, 100.0), atol=1e-3)   # capped
+    assert wall[4] > 1e-6
+
+    mesh = extrude(coarse_base, hertz_gap, N_LAYERS, wall_cell=1e-6)
+    column_z = mesh.points[:, 2].reshape(len(coarse_base.points), -1)
+    h_nodes = column_z[:, -1]
+    graded = h_nodes / N_LAYERS > 1.001e-6
+    assert graded.any() and (~graded).any()
+    np.testing.assert_allclose(column_z[graded, 1], 1e-6, rtol=0.02)  # normal columns lean
+    np.testing.assert_allclose(column_z[~graded, 1], h_nodes[~graded] / N_LAYERS, rtol=0.02)
+    # spans: each cell's bottom and top as fractions of its column, in order, 0 to 1
+    lo, hi = mesh.spans.T
+    assert np.all(hi > lo)
+    assert np.all(lo[mesh.layer == 0] == 0.0) and np.allclose(hi[mesh.layer == N_LAYERS - 1], 1.0)
+    share = mesh.cell_volumes / np.bincount(mesh.base_cell, mesh.cell_volumes)[mesh.base_cell]
+    h_quad = h_nodes[coarse_base.quads][mesh.base_cell]
+    even = h_quad.max(axis=1) < 1.15 * h_quad.min(axis=1)     # the gap's rise across a quad
+    assert even.sum() > 0.3 * len(even)
+    np.testing.assert_allclose((hi - lo)[even], share[even], rtol=0.1)
+    with pytest.raises(ValueError, match="wall_cell must be a height > 0"):
+        extrude(coarse_base, hertz_gap, N_LAYERS, wall_cell=-1e-6)
