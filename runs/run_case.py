@@ -542,8 +542,10 @@ def front_cell_warnings(front_cells: float | None) -> list[str]:
             f"converged (on the coarse walls resolving it moved the inlet meniscus 12 % "
             f"downstream); continue the run on a mesh with a band along its meniscus "
             f"(`ehlfoam band CASE --size S --half-width 1` into mesh.refine, S within "
-            f"{FRONT_CELL_WARNING:g} wall cells); docs/cases.md, \"The region's sides are moving "
-            f"contact lines\", \"A band along the meniscus\""]
+            f"{FRONT_CELL_WARNING:g} wall cells), or with one wall cell height everywhere "
+            f"(mesh.wall_cell), which thickens the wall cells in the front's narrower gap; "
+            f"docs/cases.md, \"The region's sides are moving contact lines\", \"A band along "
+            f"the meniscus\", \"One wall cell everywhere\""]
 
 
 def _final_metrics(spec, geom: CaseGeometry, structure, v0, history, reason, failed, rc, tail, wall,
