@@ -56,9 +56,10 @@ class LayeredMesh:
         out[self.base_cell, self.layer] = values
         return out
 
-    def layer_zeta(self) -> np.ndarray:
-        """The mean relative height of each layer."""
-        return np.bincount(self.layer, self.zeta) / np.bincount(self.layer)
+    def zeta_columns(self) -> np.ndarray:
+        """Each cell's relative height arranged as (columns, layers): a column's own layers,
+        which differ from column to column where each is graded its own way."""
+        return self.columns(self.zeta)
 
 
 def relative_heights(s: Structure) -> tuple[np.ndarray, np.ndarray]:
@@ -80,7 +81,7 @@ def interpolate(values: np.ndarray, source: LayeredMesh, target: LayeredMesh) ->
     k = flat.shape[1]
     # in plane: each source column's values and its layers' heights at the target columns
     cols = source.columns(flat).reshape(n_s, l_s * k)
-    zeta_s = source.columns(source.zeta[:, None])[..., 0]          # (B_s, L_s)
+    zeta_s = source.zeta_columns()                                 # (B_s, L_s)
     stacked = np.concatenate([cols, zeta_s], axis=1)
     at = LinearNDInterpolator(source.base_xy, stacked)(target.base_xy)
     outside = np.isnan(at).any(axis=1)

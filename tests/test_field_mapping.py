@@ -39,11 +39,11 @@ def test_relative_heights_span_the_gap(meshes):
     m = LayeredMesh.load(meshes[1])
     assert m.shape[1] == 5
     assert np.all((m.zeta > 0) & (m.zeta < 1))
-    z = m.layer_zeta()
+    z = m.zeta_columns().mean(axis=0)                       # each layer's mean height
     assert np.all(np.diff(z) > 0) and z[0] < 0.2 and z[-1] > 0.8
     # graded symmetrically toward both walls
     assert z[0] == pytest.approx(1 - z[-1], abs=1e-3)
-    wall = m.columns(m.zeta[:, None])[:, 0, 0]              # each column's first layer
+    wall = m.zeta_columns()[:, 0]                           # each column's first layer
     if meshes[3] == "wall_cell":      # graded more where the gap is wider, uniform at the rim
         assert wall.min() < 0.5 * wall.max() and wall.max() == pytest.approx(0.1, rel=0.02)
     else:
@@ -63,7 +63,7 @@ def test_a_linear_field_is_carried_over_exactly_inside_the_source(meshes):
     want = field(dst)
     # exact where the target cell lies between source layer centres across the gap and
     # inside the hull of the source columns in plane (outside: nearest column)
-    z_s = src.columns(src.zeta[:, None])[..., 0]          # (columns, layers)
+    z_s = src.zeta_columns()                              # (columns, layers)
     inner = (dst.zeta >= z_s[:, 0].max()) & (dst.zeta <= z_s[:, -1].min())
     in_hull = Delaunay(src.base_xy).find_simplex(dst.base_xy[dst.base_cell]) >= 0
     interior = inner & in_hull
