@@ -3,12 +3,14 @@ and a short real interFoam run of a bridge that dry walls advance into."""
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
 import pytest
-from foamlib import FoamFile
+from foamlib import FoamFieldFile, FoamFile
 
 from bench.contact_line_strip import (angle_at_meniscus, balance, meniscus_for_angle,
-                                      reverse_walls)
+                                      reverse_walls, wall_rows)
 from bench.film_deposition import columns, measure, strip_mesh, write_strip_case
 from generator.case_spec import make_case_spec
 from generator.gap_source import load_gap
@@ -58,3 +60,36 @@ def test_dry_walls_run_into_a_bridge_fed_by_the_reservoir(strip, tmp_path):
     _, h, oil = columns(mesh, alpha)
     assert oil[0] == pytest.approx(h[0], rel=0.02)
     assert oil[-1] < 0.05 * h[-1]               # the walls come in dry
+
+
+def test_wall_rows_read_the_stall_the_air_and_the_pressure_of_the_wall_cells(strip, tmp_path):
+    """Fields with a known answer: oil up to x = 6.5 a with 3 % air in its wall cells, whose
+    pressure stands 250 Pa over mid-gap; the wall cells move with their walls (-u) but for
+    the four columns around the meniscus (two oil, two air), which are at rest."""
+    spec, gap, a, mesh = strip
+    case = tmp_path / "strip"
+    write_strip_case(spec, case, mesh, x_bridge=6.5 * a, film=0.0, dx=0.5 * a, end_time=0.01,
+                     write_interval=0.01)
+    n = int(mesh.layer.max()) + 1
+    x = mesh.cell_centres[:, 0]
+    wall = (mesh.layer == 0) | (mesh.layer == n - 1)
+    alpha = np.where(x < 6.5 * a, np.where(wall, 0.97, 1.0), 0.0)
+    u = np.zeros((mesh.n_cells, 3))
+    u[wall, 0] = -spec.wall_speed
+    stalled = wall & (np.abs(x - 6.5 * a) < 0.8 * a)       # columns at 5.75-7.25 a
+    u[stalled, 0] = 0.0
+    p = np.where(wall & (x < 6.5 * a), 250.0, 0.0)
+    folder = case / "0.01"
+    shutil.copytree(case / "0", folder)
+    for name, value in (("alpha.oil", alpha), ("U", u), ("p_rgh", p)):
+        with FoamFieldFile(folder / name) as f:
+            f.internal_field = value
+    rows = wall_rows(folder, mesh, spec.wall_speed, 6.5 * a, 1.0 * a)
+    columns_at_rest = len(np.unique(mesh.base_cell[stalled]))
+    assert columns_at_rest == 4
+    assert rows["stalled_length_m"] == pytest.approx(4 * 0.5 * a, rel=0.02)
+    assert rows["wall_air_fraction"] == pytest.approx(0.03)
+    assert rows["wall_pressure_excess_pa"] == pytest.approx(250.0)
+    # within a reach of 0.3 a only the two columns either side of the meniscus count
+    near = wall_rows(folder, mesh, spec.wall_speed, 6.5 * a, 0.3 * a)
+    assert near["stalled_length_m"] == pytest.approx(2 * 0.5 * a, rel=0.02)
