@@ -530,22 +530,27 @@ def front_contact_line_cells(spec: CaseSpec, geom: CaseGeometry,
     return float(np.median(ratios)) if len(ratios) else None
 
 
-def front_cell_warnings(front_cells: float | None) -> list[str]:
+def front_cell_warnings(front_cells: float | None,
+                        isotropic_compression: float = 0.0) -> list[str]:
     """A warning when the region's front off the track, where dry walls run into it, sits in
-    cells wider than :data:`FRONT_CELL_WARNING` wall cells."""
-    if front_cells is None or front_cells <= FRONT_CELL_WARNING:
+    cells wider than :data:`FRONT_CELL_WARNING` wall cells; none with the compression taken
+    from the local speed (``physics.isotropic_compression = 1``), with which the advancing
+    line holds on any cells (docs/cases.md, "The advancing contact line and the interface
+    compression")."""
+    if front_cells is None or front_cells <= FRONT_CELL_WARNING or isotropic_compression == 1.0:
         return []
     return [f"the flooded region's front off the track, where dry walls run into it, sits in "
             f"in-plane cells {front_cells:.0f} times its wall cells (above "
             f"{FRONT_CELL_WARNING:g}): there interFoam gives the advancing contact line no "
             f"capillary suction, and neither the flooded width nor the inlet meniscus is "
             f"converged (on the coarse walls resolving it moved the inlet meniscus 12 % "
-            f"downstream); continue the run on a mesh with a band along its meniscus "
-            f"(`ehlfoam band CASE --size S --half-width 1` into mesh.refine, S within "
-            f"{FRONT_CELL_WARNING:g} wall cells), or with one wall cell height everywhere "
-            f"(mesh.wall_cell), which thickens the wall cells in the front's narrower gap; "
-            f"docs/cases.md, \"The region's sides are moving contact lines\", \"A band along "
-            f"the meniscus\", \"One wall cell everywhere\""]
+            f"downstream); take the interface compression from the local speed "
+            f"(physics.isotropic_compression = 1), with which the line holds on any cells and "
+            f"does not change with them, or continue the run on a mesh with a band along its "
+            f"meniscus (`ehlfoam band CASE --size S --half-width 1` into mesh.refine, S within "
+            f"{FRONT_CELL_WARNING:g} wall cells); docs/cases.md, \"The advancing contact "
+            f"line and the interface compression\", \"The region's sides are moving contact "
+            f"lines\""]
 
 
 def _final_metrics(spec, geom: CaseGeometry, structure, v0, history, reason, failed, rc, tail, wall,
@@ -590,9 +595,10 @@ def _final_metrics(spec, geom: CaseGeometry, structure, v0, history, reason, fai
         "ball_wall_steps": geom.ball_wall_steps,
         "rear_meniscus_cell_over_a": rear_cell,
         "front_contact_line_cells_over_wall_cell": front_cells,
-        "warnings": "; ".join(mesh_warnings(geom) + rear_cell_warnings(rear_cell)
-                              + front_cell_warnings(front_cells) + (
-            boundary_warnings(off_outlet, pattern) if surrounded else [])),
+        "warnings": "; ".join(
+            mesh_warnings(geom) + rear_cell_warnings(rear_cell)
+            + front_cell_warnings(front_cells, spec.physics.isotropic_compression)
+            + (boundary_warnings(off_outlet, pattern) if surrounded else [])),
     }
     if failed:
         log = case / geom.log_name

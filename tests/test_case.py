@@ -819,6 +819,9 @@ def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path)
         + front_cell_warnings(m["front_contact_line_cells_over_wall_cell"])), m
     assert m["front_contact_line_cells_over_wall_cell"] > FRONT_CELL_WARNING
     assert "dry walls run into it" in m["warnings"]
+    # with the compression from the local speed the advancing line holds on any cells
+    assert front_cell_warnings(m["front_contact_line_cells_over_wall_cell"], 1.0) == []
+    assert front_cell_warnings(m["front_contact_line_cells_over_wall_cell"], 0.5)
 
 
 def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
