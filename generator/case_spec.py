@@ -124,7 +124,7 @@ class Physics(BaseModel):
             compressed; 1: every face of it as hard). At 1 the wall cells move with their
             wall up to an advancing contact line, which then stands at the same place on any
             cells (on the contact-line strip 6.32-6.29 a over 0.12-0.03 a cells, where icAlpha
-            0 moves it 0.3 a per halving of the wall cells), at an apparent angle of 30-33
+            0 moves it 0.3 a per halving of the cells), at an apparent angle of 30-33
             deg that the wall's angle hardly moves; at rest it feeds the spurious currents
             (45 % of u on the coarse static meniscus): docs/cases.md, "The advancing contact
             line and the interface compression".
