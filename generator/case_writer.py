@@ -24,6 +24,7 @@ from foamlib import FoamFieldFile, FoamFile
 from ehl_precalc.outputs import atomic_write_json, atomic_write_text
 from runs.foam_runtime import FoamRuntime
 
+from . import face_oil
 from .case_spec import CaseSpec
 from .gap_source import load_gap
 from .mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
@@ -210,30 +211,23 @@ def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:
 
 
 def supply_fraction(spec: CaseSpec, mesh: PolyMesh, patch: str = "inlet") -> np.ndarray:
-    """Oil fraction of each face of ``patch`` in the supply: the part of the face inside the
-    oil layers (or the whole face, flooded) on the track; 0 elsewhere, and everywhere where
-    oil fills the domain (single-phase, submerged: the open boundaries bring oil in)."""
+    """Oil fraction of each face of ``patch`` in the supply: the share of its area, projected
+    across the flow, inside the oil layers (or the whole height, flooded) on the track, so
+    that the oil carried in is exact on any cells (:mod:`generator.face_oil`); 0 everywhere
+    where oil fills the domain (single-phase, submerged: the open boundaries bring oil in)."""
     faces = mesh.faces[mesh.patch_slice(patch)]
     if spec.fills_domain:
         return np.zeros(len(faces))
-    # a face is a vertical trapezoid: its bottom and top are the means of its two lower and
-    # two upper corners, so that the supplied area is exact
-    z = np.sort(mesh.points[faces, 2], axis=1)
-    z_lo, z_hi = z[:, :2].mean(axis=1), z[:, 2:].mean(axis=1)
-    # the column height at each face: the highest point of the faces above the same 2D
-    # edge (columns may lean, so their nodes need not share a y)
-    nodes = np.sort(mesh.base_node(faces), axis=1)
-    _, inverse = np.unique(nodes[:, [0, -1]], axis=0, return_inverse=True)
-    inverse = inverse.ravel()
-    column = np.zeros(inverse.max() + 1)
-    np.maximum.at(column, inverse, z_hi)
-    # the part of each face's width on the track (less its dry middle band, if any), so that
-    # the supply's width is exact
-    w, w_in = spec.supply.track_half_width, spec.supply.track_inner_half_width
-    y_lo, y_hi = mesh.points[faces, 1].min(axis=1), mesh.points[faces, 1].max(axis=1)
-    on_track = ((_overlap(y_lo, y_hi, -w, w) - _overlap(y_lo, y_hi, -w_in, w_in))
-                / np.maximum(y_hi - y_lo, 1e-300))
-    return oil_fraction(spec, z_lo, z_hi, column[inverse], on_track)
+    s = spec.supply
+    per_node = int(mesh.layer.max()) + 2              # points per column (extrude's order)
+    nodes = mesh.base_node(faces)
+    fractions = np.empty(len(faces))
+    for i, (face, node) in enumerate(zip(faces, nodes)):
+        tops = mesh.points[(np.unique(node) + 1) * per_node - 1][:, 1:]   # the ball, (y, z)
+        fractions[i] = face_oil.oil_fraction(
+            mesh.points[face][:, 1:], (tops[0], tops[-1]), s.disc_layer, s.ball_layer,
+            (s.track_inner_half_width, s.track_half_width), flooded=s.mode == "flooded")
+    return fractions
 
 
 def with_supply_patch(spec: CaseSpec, mesh: PolyMesh) -> tuple[PolyMesh, np.ndarray]:

@@ -380,6 +380,32 @@ def test_supply_carries_the_layers_in(small_case, tmp_path):
     assert s.oil_in == pytest.approx(expected, rel=0.05)
 
 
+def test_thin_wall_cells_under_a_sloping_ball_carry_the_whole_supply_in(tmp_path):
+    """Wall cells of 0.3 um, thinner than the ball climbs across an inlet face: the supply
+    faces' oil fractions times their areas across the flow, at u, are u x (disc + ball
+    layer) x track width to 1e-6 (corners sorted by height had taken a share of the ball's
+    layer off each face there)."""
+    spec = make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "wall_grading": None,
+                                             "wall_cell": 3e-7, "n_layers": 8}})
+    case = tmp_path / "thin"
+    write_case(spec, case)
+    poly = case / "constant" / "polyMesh"
+    points = np.asarray(FoamFile(poly / "points")[None], float)
+    faces = FoamFile(poly / "faces")[None]
+    patch = FoamFile(poly / "boundary")[None]
+    supply = next(p[1] for p in patch if p[0] == "supply")
+    start, size = int(supply["startFace"]), int(supply["nFaces"])
+    quads = points[np.asarray([faces[i] for i in range(start, start + size)])]
+    area_x = 0.5 * np.cross(quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1])[:, 0]
+    alpha = np.asarray(FoamFieldFile(case / "0.orig" / "alpha.oil")
+                       .boundary_field["supply"]["value"], float)
+    # the ball climbs across some supply face by more than that face's height
+    z = quads[:, :, 2]
+    assert np.any(z.max(axis=1) - z.min(axis=1) > 2 * 3e-7)
+    flux = 2 * spec.speed * float(np.sum(alpha * np.abs(area_x)))      # both halves
+    assert flux == pytest.approx(spec.speed * (3e-6 + 3e-6) * 2 * 2.5e-4, rel=1e-6)
+
+
 def test_side_bands_carry_their_layers_in(tmp_path):
     """With a dry middle band the oil enters only on |y| in [inner, outer]: the flux is
     u x (disc + ball layer) x 2 (outer - inner), and no supply face lies inside the band."""
