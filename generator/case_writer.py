@@ -219,11 +219,9 @@ def supply_fraction(spec: CaseSpec, mesh: PolyMesh, patch: str = "inlet") -> np.
     if spec.fills_domain:
         return np.zeros(len(faces))
     s = spec.supply
-    per_node = int(mesh.layer.max()) + 2              # points per column (extrude's order)
-    nodes = mesh.base_node(faces)
     fractions = np.empty(len(faces))
-    for i, (face, node) in enumerate(zip(faces, nodes)):
-        tops = mesh.points[(np.unique(node) + 1) * per_node - 1][:, 1:]   # the ball, (y, z)
+    for i, (face, node) in enumerate(zip(faces, mesh.base_node(faces))):
+        tops = mesh.points[mesh.top_point(np.unique(node))][:, 1:]     # the ball, (y, z)
         fractions[i] = face_oil.oil_fraction(
             mesh.points[face][:, 1:], (tops[0], tops[-1]), s.disc_layer, s.ball_layer,
             (s.track_inner_half_width, s.track_half_width), flooded=s.mode == "flooded")

@@ -667,11 +667,21 @@ class PolyMesh:
     def n_internal_faces(self) -> int:
         return len(self.neighbour)
 
+    @property
+    def _points_per_node(self) -> int:
+        """n_layers + 1: the levels of each base node's column (:func:`extrude`'s order)."""
+        return int(self.layer.max()) + 2
+
     def base_node(self, point_ids: np.ndarray) -> np.ndarray:
         """The 2D base-mesh node of each point id: point ``p`` is a level of node
         ``p // (n_layers + 1)`` (:func:`extrude`'s order), whether or not its column
         leans."""
-        return np.asarray(point_ids) // (int(self.layer.max()) + 2)
+        return np.asarray(point_ids) // self._points_per_node
+
+    def top_point(self, nodes: np.ndarray) -> np.ndarray:
+        """The point id of the top of each 2D base-mesh node's column, on the ball (the
+        inverse of :meth:`base_node` at the last level)."""
+        return (np.asarray(nodes) + 1) * self._points_per_node - 1
 
     def patch(self, name: str) -> Patch:
         """The patch called ``name`` (KeyError if absent)."""
