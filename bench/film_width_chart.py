@@ -93,7 +93,7 @@ def case_point(case: Path, table: dict, n_fit: int) -> dict:
     """A 3D case's wall layers, rear cells, strip f / LL there, and width (last, balance)."""
     spec = load_spec_of(case)
     level = spec.mesh.level()
-    layers = (int(level["n_layers"]), float(level["wall_grading"]))
+    layers = (int(level["n_layers"]), level["wall_grading"])  # None under one wall cell
     result = analyse(case, n_fit)
     last = result["per_transit"][-1]
     dx = rear_cell_size(spec, last)

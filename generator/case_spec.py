@@ -387,13 +387,19 @@ class Mesh(BaseModel):
                              f"grading")
         return self
 
-    def level(self) -> dict[str, float]:
-        """The level's sizes with the overrides applied."""
+    def level(self) -> dict[str, float | None]:
+        """The level's sizes with the overrides applied: ``n_layers``, ``size_rim`` and
+        ``size_far`` (a), ``wall_grading`` (-) and ``wall_cell`` [m]. One of the last two
+        is None: with ``wall_cell`` set the columns are graded for it and the level's
+        grading does not apply."""
         out = dict(RESOLUTIONS[self.resolution])
         for key in ("n_layers", "size_rim", "size_far", "wall_grading"):
             if getattr(self, key) is not None:
                 out[key] = getattr(self, key)
         out["n_layers"] = int(out["n_layers"])
+        out["wall_cell"] = self.wall_cell
+        if self.wall_cell is not None:
+            out["wall_grading"] = None
         return out
 
 

@@ -187,8 +187,8 @@ def extrude_level(spec: CaseSpec, base: BaseMesh, gap) -> PolyMesh:
     """``base`` extruded across ``gap(x, y)`` [m] in the spec's layers: the level's count and
     wall grading, or one wall cell height everywhere (``mesh.wall_cell``)."""
     level = spec.mesh.level()
-    return extrude(base, gap, level["n_layers"], level["wall_grading"], spec.mesh.columns,
-                   wall_cell=spec.mesh.wall_cell)
+    return extrude(base, gap, level["n_layers"], level["wall_grading"] or 1.0,
+                   spec.mesh.columns, wall_cell=level["wall_cell"])
 
 
 def initial_alpha(spec: CaseSpec, mesh: PolyMesh, gap) -> np.ndarray:

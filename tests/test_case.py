@@ -107,6 +107,16 @@ def test_polar_ring_is_the_default_and_auto_follows_the_domain():
     assert make_case_spec(**{"mesh.polar_radius": parse_value("none")}).polar_radius is None
 
 
+def test_the_level_reports_the_wall_rule_the_mesh_is_built_with():
+    """Under mesh.wall_cell the level's wall grading does not apply, and level() says so
+    (it used to report the level's grading beside a mesh graded for the wall cell)."""
+    graded = make_case_spec().mesh.level()
+    assert graded["wall_cell"] is None and graded["wall_grading"] == 10.0
+    one_cell = make_case_spec(**{"mesh.wall_cell": 8e-7}).mesh.level()
+    assert one_cell["wall_cell"] == 8e-7 and one_cell["wall_grading"] is None
+    assert one_cell["n_layers"] == graded["n_layers"]
+
+
 def test_spec_defaults_are_the_reference_case():
     spec = make_case_spec()
     assert spec.contact.load == 20.0 and spec.contact.temperature == 40.0
