@@ -215,8 +215,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--wall-limit", type=float, default=None,
                      help="wall-clock limit [s] (default: the spec's run.wall_limit)")
     run.add_argument("--extend", type=_positive_float, default=None, metavar="TRANSITS",
-                     help="go on for TRANSITS transit times past the latest written time, "
-                          "whatever the steady-state tests say (does a steady state last?)")
+                     help="go on for TRANSITS transit times past the latest written time (from 0 "
+                          "in a case not run yet), whatever the steady-state tests say (does "
+                          "a steady state last?)")
     run.add_argument("--quiet", action="store_true", help="no line per written time")
     run.set_defaults(func=cmd_run)
 

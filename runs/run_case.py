@@ -331,12 +331,19 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
 
 
 def _extend_end_time(case: Path, geom: CaseGeometry, transits: float) -> None:
-    """Set controlDict's endTime ``transits`` transit times past the latest written time."""
+    """Set controlDict's endTime ``transits`` transit times past the latest written time, or
+    past 0 for a case that has not run yet (a case seeded from another one's state runs
+    ``transits`` from its start)."""
     folders = case_fields.time_folders(case)
-    if not folders:
-        raise FileNotFoundError(f"{case} has no written time to extend: run it first")
+    if folders:
+        start = folders[-1][0]
+    elif (case / "0.orig").is_dir() or (case / "0").is_dir():
+        start = 0.0
+    else:
+        raise FileNotFoundError(f"{case} has no written time nor initial fields (0.orig/) "
+                                "to extend from")
     with FoamFile(case / "system" / "controlDict") as f:
-        f["endTime"] = folders[-1][0] + transits * geom.transit_time
+        f["endTime"] = start + transits * geom.transit_time
 
 
 def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample,

@@ -1021,15 +1021,17 @@ def test_monitor_stops_a_steady_run(tmp_path):
 def test_cli_run_prints_metrics_and_exit_code(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:
-        f["endTime"] = 2e-4
         f["writeInterval"] = 1e-4
-    proc = subprocess.run([*EHLFOAM, "run", str(case)], capture_output=True, text=True,
-                          timeout=300)
+    # --extend on a case that has not run yet counts from its start: 2e-4 s of simulated time
+    transits = 2e-4 / load_geometry(case).transit_time
+    proc = subprocess.run([*EHLFOAM, "run", str(case), "--extend", f"{transits!r}"],
+                          capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.strip().splitlines()
     assert any(ln.startswith("t =") and "state" in ln for ln in lines)   # progress lines
     result = json.loads(lines[-1])
     assert result["status"] == "finished" and result["end_reason"] == "end_time"
+    assert result["simulated_time_s"] == pytest.approx(2e-4, rel=1e-3)
     busy = subprocess.run([*EHLFOAM, "run", str(tmp_path / "nowhere")], capture_output=True,
                           text=True)
     assert busy.returncode == 2 and "nowhere" in busy.stderr
