@@ -162,3 +162,57 @@ def over_cases(cases: list[Path], sizes: list[float] | None = None) -> dict:
         noise = 2 * max(s["jitter"][k] for s in states)
         out[k] = observed_order(tuple(sizes), tuple(vals), noise=noise)
     return out
+
+
+def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0.036) -> dict:
+    """The value a metric comes to rest at on one mesh, read off runs that approach it (say one
+    from above and one from below) before any of them gets there.
+
+    Each run is a pair (times [transits], values). Fitted jointly by least squares: f_i(t) =
+    f_rest + (f_i0 - f_rest) exp(-(t - t_i0) / tau), one rest value f_rest and one relaxation
+    time tau [transits] for all runs, each run its own start value f_i0 (t_i0 its first
+    time). The model-free reading beside it: a run that ends rising and one that ends
+    falling bracket the rest value between their last values, if neither overshoots it.
+
+    Returns {"rest", "rest_sd", "tau", "tau_sd", "rms" (the fit's residual), "bracket" ([low,
+    high] or None), "runs": [{"first", "last", "t_first", "t_last", "rate" (the slope over
+    the last ``rate_window`` transits, per transit), "writes"}]}. Raises ValueError when the
+    runs hold fewer writes than the model has unknowns plus one.
+    """
+    from scipy.optimize import least_squares
+
+    runs = [(np.asarray(t, dtype=float), np.asarray(f, dtype=float)) for t, f in runs]
+    n = sum(len(t) for t, _ in runs)
+    if not runs or n < len(runs) + 3 or any(len(t) < 2 for t, _ in runs):
+        raise ValueError(f"runs: need at least two writes a run and {len(runs) + 3} in all, "
+                         f"got {[len(t) for t, _ in runs]}")
+    summary = []
+    for t, f in runs:
+        last = t >= t[-1] - rate_window * (1 + 1e-9)
+        rate = float(np.polyfit(t[last], f[last], 1)[0]) if last.sum() > 1 else 0.0
+        summary.append({"first": float(f[0]), "last": float(f[-1]), "t_first": float(t[0]),
+                        "t_last": float(t[-1]), "rate": rate, "writes": int(len(t))})
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        rest, tau = x[0], x[1]
+        return np.concatenate([rest + (f0 - rest) * np.exp(-(t - t[0]) / tau) - f
+                               for (t, f), f0 in zip(runs, x[2:])])
+
+    span = max(t[-1] - t[0] for t, _ in runs)
+    x0 = np.array([np.mean([f[-1] for _, f in runs]), max(span, 1e-6)] +
+                  [f[0] for _, f in runs])
+    lower = np.r_[-np.inf, 1e-3 * x0[1], np.full(len(runs), -np.inf)]
+    fit = least_squares(residual, x0, bounds=(lower, np.inf))
+    dof = max(n - len(x0), 1)
+    rms = float(np.sqrt(np.sum(fit.fun ** 2) / n))
+    try:
+        cov = np.linalg.inv(fit.jac.T @ fit.jac) * np.sum(fit.fun ** 2) / dof
+        sd = np.sqrt(np.abs(np.diag(cov)))
+    except np.linalg.LinAlgError:
+        sd = np.full(len(x0), np.inf)
+    rising = [s["last"] for s in summary if s["rate"] > 0]
+    falling = [s["last"] for s in summary if s["rate"] < 0]
+    bracket = ([max(rising), min(falling)] if rising and falling and max(rising) <= min(falling)
+               else None)
+    return {"rest": float(fit.x[0]), "rest_sd": float(sd[0]), "tau": float(fit.x[1]),
+            "tau_sd": float(sd[1]), "rms": rms, "bracket": bracket, "runs": summary}

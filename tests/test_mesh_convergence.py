@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 from bench.mesh_convergence import at_time
+from bench.rest_value import main as rest_value_main
 from generator.case_writer import META
-from runs.convergence import METRICS, last_transit, observed_order, window_mean
+from runs.convergence import METRICS, last_transit, observed_order, rest_value, window_mean
 from tiny import tiny_geometry
 
 
@@ -74,16 +75,18 @@ def test_an_order_far_from_the_schemes_is_flagged_not_asymptotic():
     assert observed_order((0.2, 0.1, 0.05), (14.4, 14.1, 14.025))["asymptotic"] is True
 
 
-def _case_with_history(folder: Path, times: np.ndarray, inlet: np.ndarray) -> Path:
+def _case_with_history(folder: Path, times: np.ndarray, inlet: np.ndarray,
+                       width: np.ndarray | None = None) -> Path:
     """A case folder with a made-up geometry (transit 0.1 s) and a history.csv whose inlet
-    meniscus is ``inlet`` and whose width grows by 1 a a second."""
+    meniscus is ``inlet`` and whose width is ``width`` (default: growing by 1 a a second)."""
     (folder / META).mkdir(parents=True)
     (folder / META / "geometry.json").write_text(json.dumps(asdict(tiny_geometry())))
+    width = 12.0 + times if width is None else width
     with open(folder / "history.csv", "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["time_s", "state", *METRICS])
-        for t, x in zip(times, inlet):
-            w.writerow([t, "I", x, 12.0 + t, 18.0, 1.5e-10])
+        for t, x, y in zip(times, inlet, width):
+            w.writerow([t, "I", x, y, 18.0, 1.5e-10])
     return folder
 
 
@@ -104,3 +107,57 @@ def test_a_window_averages_out_a_meniscus_that_jumps_write_by_write(tmp_path):
     assert last["writes_averaged"] == 11 and last["time_s"] == pytest.approx(0.6)
     assert last == window_mean(case, None, 1.0)
     assert last["flooded_width_over_a"] == pytest.approx(12.55)
+
+
+def _relaxing(t: np.ndarray, start: float, rest: float = 15.07, tau: float = 0.23) -> np.ndarray:
+    """A metric relaxing from ``start`` at t[0] to ``rest`` with time constant ``tau``."""
+    return rest + (start - rest) * np.exp(-(t - t[0]) / tau)
+
+
+def test_runs_from_both_sides_give_the_rest_they_relax_to():
+    above, below = np.arange(1, 16) * 0.012, np.arange(1, 17) * 0.012
+    runs = [(above, _relaxing(above, 15.45)), (below, _relaxing(below, 14.86))]
+    r = rest_value(runs)
+    assert r["rest"] == pytest.approx(15.07, abs=1e-6)
+    assert r["tau"] == pytest.approx(0.23, rel=1e-4)
+    assert r["rms"] < 1e-8
+    low, high = r["bracket"]
+    assert low == pytest.approx(runs[1][1][-1]) and high == pytest.approx(runs[0][1][-1])
+    assert low < 15.07 < high
+    assert r["runs"][0]["rate"] < 0 < r["runs"][1]["rate"]
+    # a write-to-write jitter of 0.003 a still reads the rest within 0.02 a
+    rng = np.random.default_rng(1)
+    noisy = rest_value([(t, f + rng.normal(0.0, 0.003, t.size)) for t, f in runs])
+    assert noisy["rest"] == pytest.approx(15.07, abs=0.02)
+    assert 0 < noisy["rest_sd"] < 0.05
+
+
+def test_one_run_that_got_there_gives_its_rest_and_no_bracket():
+    t = np.arange(5, 92) * 0.012
+    r = rest_value([(t, _relaxing(t, 15.3, rest=14.87, tau=0.2))])
+    assert r["rest"] == pytest.approx(14.87, abs=1e-6)
+    assert r["bracket"] is None
+
+
+def test_too_few_writes_are_refused():
+    t = np.array([0.1, 0.2])
+    with pytest.raises(ValueError, match="at least two writes"):
+        rest_value([(t, t), (t[:1], t[:1])])
+    with pytest.raises(ValueError, match="4 in all"):
+        rest_value([(t, t)])
+
+
+def test_rest_value_bench_reads_two_histories(tmp_path, capsys):
+    # writes every 0.0012 s = 0.012 transits (transit 0.1 s); the second run from 0.036 on
+    t = np.arange(1, 17) * 0.0012
+    above = _case_with_history(tmp_path / "above", t, np.full(t.size, 5.0),
+                               _relaxing(t / 0.1, 15.45))
+    below = _case_with_history(tmp_path / "below", t, np.full(t.size, 5.0),
+                               np.r_[np.full(2, 14.5), _relaxing(t[2:] / 0.1, 14.86)])
+    assert rest_value_main([str(above), f"{below}@0.036", "--save",
+                            str(tmp_path / "rest.json")]) == 0
+    record = json.loads((tmp_path / "rest.json").read_text())
+    width = record["metrics"]["flooded_width_over_a"]
+    assert width["rest"] == pytest.approx(15.07, abs=1e-5)
+    assert width["runs"][1]["writes"] == 14 and width["runs"][1]["first"] == pytest.approx(14.86)
+    assert "rest 15.070" in capsys.readouterr().out

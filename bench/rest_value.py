@@ -1,0 +1,85 @@
+"""Where a metric comes to rest on one mesh, from runs that approach it before they get there:
+say one run of the mesh from above (started from a wider region) and one from below
+(started from a coarser mesh's rest). Each run's history.csv gives the metric write by
+write; ``runs.convergence.rest_value`` fits one rest value and one relaxation time to all of
+them and brackets the rest between a run that ends rising and one that ends falling.
+
+    python bench/rest_value.py CASE[@T0] [CASE[@T0] ...] [--metrics KEY ...]
+        [--rate-window W] [--save NAME.json] [--note TEXT]
+
+``CASE@T0`` reads that run from T0 transits on (to leave out the start, where a mapped state
+settles on its new mesh). Times are each run's own, in transits. Writes
+``bench/results/NAME.json`` (default rest_value.json).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from bench.common import save  # noqa: E402
+from generator.case_writer import load_geometry  # noqa: E402
+from runs.convergence import (METRICS, history_number, read_history_rows,  # noqa: E402
+                              rest_value)
+
+
+def series(case: Path, key: str, t0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(times [transits], values) of ``key`` in the case's history.csv from ``t0`` transits on,
+    leaving out writes where the metric is undefined."""
+    transit = load_geometry(case).transit_time
+    pairs = [(float(r["time_s"]) / transit, v) for r in read_history_rows(case)
+             if (v := history_number(r.get(key))) is not None]
+    pairs = [(t, v) for t, v in pairs if t >= t0 - 1e-9]
+    return np.array([t for t, _ in pairs]), np.array([v for _, v in pairs])
+
+
+def parse_case(text: str) -> tuple[Path, float]:
+    """``CASE`` or ``CASE@T0`` -> (case folder, T0 transits)."""
+    case, _, t0 = text.partition("@")
+    return Path(case), float(t0) if t0 else 0.0
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("cases", nargs="+", help="CASE or CASE@T0 (read from T0 transits on)")
+    ap.add_argument("--metrics", nargs="+", default=["flooded_width_over_a"], choices=METRICS)
+    ap.add_argument("--rate-window", type=float, default=0.036, metavar="W",
+                    help="transits at the end of each run its rate is read over")
+    ap.add_argument("--save", default="rest_value.json", help="record name under bench/results/")
+    ap.add_argument("--note", default="")
+    args = ap.parse_args(argv)
+    cases = [parse_case(c) for c in args.cases]
+    for case, _ in cases:
+        if not (case / "history.csv").is_file():
+            ap.error(f"cases: {case} has no history.csv (run it first)")
+    out = {}
+    for key in args.metrics:
+        runs = [series(case, key, t0) for case, t0 in cases]
+        try:
+            r = rest_value(runs, rate_window=args.rate_window)
+        except ValueError as err:
+            ap.error(f"{key}: {err}")
+        out[key] = r
+        print(key)
+        for (case, t0), s in zip(cases, r["runs"]):
+            print(f"  {case.parent.name:42s} from {s['t_first']:.3f} to {s['t_last']:.3f} "
+                  f"transits ({s['writes']} writes): {s['first']:.3f} -> {s['last']:.3f}, "
+                  f"{s['rate']:+.3f} a transit at the end")
+        bracket = ("none (no run ends rising below one that ends falling)"
+                   if r["bracket"] is None else f"{r['bracket'][0]:.3f} - {r['bracket'][1]:.3f}")
+        print(f"  rest {r['rest']:.3f} +- {r['rest_sd']:.3f}, relaxation time {r['tau']:.3f} "
+              f"+- {r['tau_sd']:.3f} transits, fit rms {r['rms']:.4f}; bracket {bracket}")
+    path = save(args.save, {"note": args.note, "cases": args.cases,
+                            "rate_window": args.rate_window, "metrics": out})
+    print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
