@@ -25,18 +25,17 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
-from runs.convergence import (METRICS, history_number, read_history_rows,  # noqa: E402
-                              rest_value)
+from runs.convergence import METRICS, rest_value  # noqa: E402
+from runs.report.case_data import read_history  # noqa: E402
 
 
 def series(case: Path, key: str, t0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """(times [transits], values) of ``key`` in the case's history.csv from ``t0`` transits on,
     leaving out writes where the metric is undefined."""
-    transit = load_geometry(case).transit_time
-    pairs = [(float(r["time_s"]) / transit, v) for r in read_history_rows(case)
-             if (v := history_number(r.get(key))) is not None]
-    pairs = [(t, v) for t, v in pairs if t >= t0 - 1e-9]
-    return np.array([t for t, _ in pairs]), np.array([v for _, v in pairs])
+    history = read_history(case / "history.csv")
+    t, f = history["time_s"] / load_geometry(case).transit_time, history[key]
+    keep = np.isfinite(f) & (t >= t0 - 1e-9)
+    return t[keep], f[keep]
 
 
 def parse_case(text: str) -> tuple[Path, float]:
