@@ -24,6 +24,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
+from bench.plot_midgap import _pick  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
 from runs.convergence import METRICS, rest_value  # noqa: E402
 from runs.report.case_data import read_history  # noqa: E402
@@ -38,12 +39,6 @@ def series(case: Path, key: str, t0: float = 0.0) -> tuple[np.ndarray, np.ndarra
     return t[keep], f[keep]
 
 
-def parse_case(text: str) -> tuple[Path, float]:
-    """``CASE`` or ``CASE@T0`` -> (case folder, T0 transits)."""
-    case, _, t0 = text.partition("@")
-    return Path(case), float(t0) if t0 else 0.0
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("cases", nargs="+", help="CASE or CASE@T0 (read from T0 transits on)")
@@ -53,7 +48,7 @@ def main(argv=None) -> int:
     ap.add_argument("--save", default="rest_value.json", help="record name under bench/results/")
     ap.add_argument("--note", default="")
     args = ap.parse_args(argv)
-    cases = [parse_case(c) for c in args.cases]
+    cases = [(case, t0 or 0.0) for case, t0 in map(_pick, args.cases)]
     for case, _ in cases:
         if not (case / "history.csv").is_file():
             ap.error(f"cases: {case} has no history.csv (run it first)")
