@@ -2,7 +2,8 @@
 say one run of the mesh from above (started from a wider region) and one from below
 (started from a coarser mesh's rest). Each run's history.csv gives the metric write by
 write; ``runs.convergence.rest_value`` fits one rest value and one relaxation time to all of
-them and brackets the rest between a run that ends rising and one that ends falling.
+them and brackets the rest between a run that ends rising and one that ends falling; each
+run fitted alone says whether one relaxation fits them all.
 
     python bench/rest_value.py CASE[@T0] [CASE[@T0] ...] [--metrics KEY ...]
         [--rate-window W] [--save NAME.json] [--note TEXT]
@@ -65,10 +66,20 @@ def main(argv=None) -> int:
             print(f"  {case.parent.name:42s} from {s['t_first']:.3f} to {s['t_last']:.3f} "
                   f"transits ({s['writes']} writes): {s['first']:.3f} -> {s['last']:.3f}, "
                   f"{s['rate']:+.3f} a transit at the end")
+            if s["alone"] is not None:
+                a = s["alone"]
+                print(f"  {'':42s} alone: " + (
+                    f"rest {a['rest']:.3f} +- {a['rest_sd']:.3f}, relaxation time "
+                    f"{a['tau']:.3f} +- {a['tau_sd']:.3f} transits" if a["fixed"] else
+                    "fixes no rest of its own (its relaxation time is not determined)"))
         bracket = ("none (no run ends rising below one that ends falling)"
                    if r["bracket"] is None else f"{r['bracket'][0]:.3f} - {r['bracket'][1]:.3f}")
         print(f"  rest {r['rest']:.3f} +- {r['rest_sd']:.3f}, relaxation time {r['tau']:.3f} "
               f"+- {r['tau_sd']:.3f} transits, fit rms {r['rms']:.4f}; bracket {bracket}")
+        print("  " + {True: "the runs' own rests agree: one relaxation fits them all",
+                      False: "the runs' own rests disagree: one relaxation does not fit them all",
+                      None: "fewer than two runs fix a rest of their own: the joint rest "
+                            "stands on the model"}[r["consistent"]])
     path = save(args.save, {"note": args.note, "cases": args.cases,
                             "rate_window": args.rate_window, "metrics": out})
     print(f"wrote {path}")

@@ -166,6 +166,33 @@ def over_cases(cases: list[Path], sizes: list[float] | None = None) -> dict:
     return out
 
 
+def _relaxation_fit(runs: list[tuple[np.ndarray, np.ndarray]]) -> dict:
+    """Least-squares fit of f_i(t) = rest + (f_i0 - rest) exp(-(t - t_i0) / tau) to the runs:
+    one rest value and one relaxation time tau [transits] for all, each run its own start
+    value f_i0. Returns {"rest", "rest_sd", "tau", "tau_sd", "rms"}."""
+    from scipy.optimize import least_squares
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        rest, tau = x[0], x[1]
+        return np.concatenate([rest + (f0 - rest) * np.exp(-(t - t[0]) / tau) - f
+                               for (t, f), f0 in zip(runs, x[2:])])
+
+    n = sum(len(t) for t, _ in runs)
+    span = max(t[-1] - t[0] for t, _ in runs)
+    x0 = np.array([np.mean([f[-1] for _, f in runs]), max(span, 1e-6)] +
+                  [f[0] for _, f in runs])
+    lower = np.r_[-np.inf, 1e-3 * x0[1], np.full(len(runs), -np.inf)]
+    fit = least_squares(residual, x0, bounds=(lower, np.inf))
+    dof = max(n - len(x0), 1)
+    try:
+        cov = np.linalg.inv(fit.jac.T @ fit.jac) * np.sum(fit.fun ** 2) / dof
+        sd = np.sqrt(np.abs(np.diag(cov)))
+    except np.linalg.LinAlgError:
+        sd = np.full(len(x0), np.inf)
+    return {"rest": float(fit.x[0]), "rest_sd": float(sd[0]), "tau": float(fit.x[1]),
+            "tau_sd": float(sd[1]), "rms": float(np.sqrt(np.sum(fit.fun ** 2) / n))}
+
+
 def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0.036) -> dict:
     """The value a metric comes to rest at on one mesh, read off runs that approach it (say one
     from above and one from below) before any of them gets there.
@@ -175,14 +202,21 @@ def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0
     time tau [transits] for all runs, each run its own start value f_i0 (t_i0 its first
     time). The model-free reading beside it: a run that ends rising and one that ends
     falling bracket the rest value between their last values, if neither overshoots it.
+    Where there is more than one run, each run with at least four writes is also fitted
+    alone. A run fixes a rest of its own ("fixed") when its relaxation time comes out to
+    better than half of itself: a run that is still on a straight line does not. The joint
+    fit is ``consistent`` when the own rests of the runs that fix one agree within twice
+    their combined standard deviation (and a relative 1e-6, the fit's own precision): one
+    relaxation describes them all. With fewer than two such runs that is not known (None),
+    and the joint rest stands on the model alone.
 
     Returns {"rest", "rest_sd", "tau", "tau_sd", "rms" (the fit's residual), "bracket" ([low,
-    high] or None), "runs": [{"first", "last", "t_first", "t_last", "rate" (the slope over
-    the last ``rate_window`` transits, per transit), "writes"}]}. Raises ValueError when the
-    runs hold fewer writes than the model has unknowns plus one.
+    high] or None), "consistent" (bool, or None with fewer than two runs that fix a rest of
+    their own), "runs": [{"first", "last", "t_first", "t_last", "rate" (the slope over the
+    last ``rate_window`` transits, per transit), "writes", "alone" (that run's own fit with
+    "fixed", or None)}]}. Raises ValueError when the runs hold fewer writes than the model has unknowns
+    plus one.
     """
-    from scipy.optimize import least_squares
-
     runs = [(np.asarray(t, dtype=float), np.asarray(f, dtype=float)) for t, f in runs]
     n = sum(len(t) for t, _ in runs)
     if not runs or n < len(runs) + 3 or any(len(t) < 2 for t, _ in runs):
@@ -192,29 +226,23 @@ def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0
     for t, f in runs:
         last = t >= t[-1] - rate_window * (1 + 1e-9)
         rate = float(np.polyfit(t[last], f[last], 1)[0]) if last.sum() > 1 else 0.0
+        alone = None
+        if len(runs) > 1 and len(t) >= 4:
+            alone = _relaxation_fit([(t, f)])
+            alone["fixed"] = bool(math.isfinite(alone["rest_sd"])
+                                  and alone["tau_sd"] < 0.5 * alone["tau"])
         summary.append({"first": float(f[0]), "last": float(f[-1]), "t_first": float(t[0]),
-                        "t_last": float(t[-1]), "rate": rate, "writes": int(len(t))})
-
-    def residual(x: np.ndarray) -> np.ndarray:
-        rest, tau = x[0], x[1]
-        return np.concatenate([rest + (f0 - rest) * np.exp(-(t - t[0]) / tau) - f
-                               for (t, f), f0 in zip(runs, x[2:])])
-
-    span = max(t[-1] - t[0] for t, _ in runs)
-    x0 = np.array([np.mean([f[-1] for _, f in runs]), max(span, 1e-6)] +
-                  [f[0] for _, f in runs])
-    lower = np.r_[-np.inf, 1e-3 * x0[1], np.full(len(runs), -np.inf)]
-    fit = least_squares(residual, x0, bounds=(lower, np.inf))
-    dof = max(n - len(x0), 1)
-    rms = float(np.sqrt(np.sum(fit.fun ** 2) / n))
-    try:
-        cov = np.linalg.inv(fit.jac.T @ fit.jac) * np.sum(fit.fun ** 2) / dof
-        sd = np.sqrt(np.abs(np.diag(cov)))
-    except np.linalg.LinAlgError:
-        sd = np.full(len(x0), np.inf)
+                        "t_last": float(t[-1]), "rate": rate, "writes": int(len(t)),
+                        "alone": alone})
+    joint = _relaxation_fit(runs)
     rising = [s["last"] for s in summary if s["rate"] > 0]
     falling = [s["last"] for s in summary if s["rate"] < 0]
     bracket = ([max(rising), min(falling)] if rising and falling and max(rising) <= min(falling)
                else None)
-    return {"rest": float(fit.x[0]), "rest_sd": float(sd[0]), "tau": float(fit.x[1]),
-            "tau_sd": float(sd[1]), "rms": rms, "bracket": bracket, "runs": summary}
+    alone = [s["alone"] for s in summary if s["alone"] is not None and s["alone"]["fixed"]]
+    consistent = None
+    if len(alone) > 1:
+        consistent = all(abs(a["rest"] - b["rest"]) <=
+                         2 * math.hypot(a["rest_sd"], b["rest_sd"]) + 1e-6 * abs(a["rest"])
+                         for k, a in enumerate(alone) for b in alone[k + 1:])
+    return {**joint, "bracket": bracket, "consistent": consistent, "runs": summary}

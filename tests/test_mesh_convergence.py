@@ -130,6 +130,25 @@ def test_runs_from_both_sides_give_the_rest_they_relax_to():
     noisy = rest_value([(t, f + rng.normal(0.0, 0.003, t.size)) for t, f in runs])
     assert noisy["rest"] == pytest.approx(15.07, abs=0.02)
     assert 0 < noisy["rest_sd"] < 0.05
+    assert noisy["consistent"] is True                # each run alone finds the same rest
+    for run in noisy["runs"]:
+        assert abs(run["alone"]["rest"] - 15.07) < 3 * run["alone"]["rest_sd"]
+
+
+def test_runs_relaxing_to_different_rests_are_not_one_relaxation():
+    # from above to 15.07 in 0.23 transits, from below to 14.88 in 0.05 (it stalls early):
+    # the joint fit still returns a value between the two and fits them within 1.5 times the
+    # jitter, but the runs' own fits say it is not one rest
+    rng = np.random.default_rng(2)
+    above, below = np.arange(1, 20) * 0.012, np.arange(1, 14) * 0.012
+    runs = [(above, _relaxing(above, 15.45) + rng.normal(0.0, 0.003, above.size)),
+            (below, _relaxing(below, 14.86, rest=14.88, tau=0.05)
+             + rng.normal(0.0, 0.003, below.size))]
+    r = rest_value(runs)
+    assert r["consistent"] is False
+    assert r["runs"][0]["alone"]["rest"] == pytest.approx(15.07, abs=0.05)
+    assert r["runs"][1]["alone"]["rest"] == pytest.approx(14.88, abs=0.01)
+    assert 14.88 < r["rest"] < 15.07 and r["rms"] < 0.0045
 
 
 def test_one_run_that_got_there_gives_its_rest_and_no_bracket():
@@ -137,6 +156,7 @@ def test_one_run_that_got_there_gives_its_rest_and_no_bracket():
     r = rest_value([(t, _relaxing(t, 15.3, rest=14.87, tau=0.2))])
     assert r["rest"] == pytest.approx(14.87, abs=1e-6)
     assert r["bracket"] is None
+    assert r["consistent"] is None and r["runs"][0]["alone"] is None   # nothing to compare
 
 
 def test_too_few_writes_are_refused():
@@ -160,4 +180,6 @@ def test_rest_value_bench_reads_two_histories(tmp_path, capsys):
     width = record["metrics"]["flooded_width_over_a"]
     assert width["rest"] == pytest.approx(15.07, abs=1e-5)
     assert width["runs"][1]["writes"] == 14 and width["runs"][1]["first"] == pytest.approx(14.86)
-    assert "rest 15.070" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "rest 15.070" in out
+    assert width["consistent"] is True and "agree: one relaxation fits them all" in out
