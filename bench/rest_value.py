@@ -76,10 +76,11 @@ def main(argv=None) -> int:
                    if r["bracket"] is None else f"{r['bracket'][0]:.3f} - {r['bracket'][1]:.3f}")
         print(f"  rest {r['rest']:.3f} +- {r['rest_sd']:.3f}, relaxation time {r['tau']:.3f} "
               f"+- {r['tau_sd']:.3f} transits, fit rms {r['rms']:.4f}; bracket {bracket}")
-        print("  " + {True: "the runs' own rests agree: one relaxation fits them all",
-                      False: "the runs' own rests disagree: one relaxation does not fit them all",
-                      None: "fewer than two runs fix a rest of their own: the joint rest "
-                            "stands on the model"}[r["consistent"]])
+        if len(cases) > 1:
+            print("  " + {True: "the runs' own rests agree: one relaxation fits them all",
+                          False: "the runs' own rests disagree: one relaxation does not fit them all",
+                          None: "fewer than two runs fix a rest of their own: the joint rest "
+                                "stands on the model"}[r["consistent"]])
     path = save(args.save, {"note": args.note, "cases": args.cases,
                             "rate_window": args.rate_window, "metrics": out})
     print(f"wrote {path}")
