@@ -78,7 +78,8 @@ def main(argv=None) -> int:
               f"+- {r['tau_sd']:.3f} transits, fit rms {r['rms']:.4f}; bracket {bracket}")
         if len(cases) > 1:
             print("  " + {True: "the runs' own rests agree: one relaxation fits them all",
-                          False: "the runs' own rests disagree: one relaxation does not fit them all",
+                          False: "the runs' own rests disagree: one relaxation does not fit "
+                                 "them all",
                           None: "fewer than two runs fix a rest of their own: the joint rest "
                                 "stands on the model"}[r["consistent"]])
     path = save(args.save, {"note": args.note, "cases": args.cases,

@@ -214,8 +214,8 @@ def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0
     high] or None), "consistent" (bool, or None with fewer than two runs that fix a rest of
     their own), "runs": [{"first", "last", "t_first", "t_last", "rate" (the slope over the
     last ``rate_window`` transits, per transit), "writes", "alone" (that run's own fit with
-    "fixed", or None)}]}. Raises ValueError when the runs hold fewer writes than the model has unknowns
-    plus one.
+    "fixed", or None)}]}. Raises ValueError when the runs hold fewer writes than the model
+    has unknowns plus one.
     """
     runs = [(np.asarray(t, dtype=float), np.asarray(f, dtype=float)) for t, f in runs]
     n = sum(len(t) for t, _ in runs)
