@@ -204,7 +204,8 @@ def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0
     falling bracket the rest value between their last values, if neither overshoots it.
     Where there is more than one run, each run with at least four writes is also fitted
     alone. A run fixes a rest of its own ("fixed") when its relaxation time comes out to
-    better than half of itself: a run that is still on a straight line does not. The joint
+    better than half of itself and the run spans at least half of it: a run that is still
+    on a straight line, whose curve gives no rest, does not. The joint
     fit is ``consistent`` when the own rests of the runs that fix one agree within twice
     their combined standard deviation (and a relative 1e-6, the fit's own precision): one
     relaxation describes them all. With fewer than two such runs that is not known (None),
@@ -230,7 +231,8 @@ def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0
         if len(runs) > 1 and len(t) >= 4:
             alone = _relaxation_fit([(t, f)])
             alone["fixed"] = bool(math.isfinite(alone["rest_sd"])
-                                  and alone["tau_sd"] < 0.5 * alone["tau"])
+                                  and alone["tau_sd"] < 0.5 * alone["tau"]
+                                  and alone["tau"] <= 2 * (t[-1] - t[0]))
         summary.append({"first": float(f[0]), "last": float(f[-1]), "t_first": float(t[0]),
                         "t_last": float(t[-1]), "rate": rate, "writes": int(len(t)),
                         "alone": alone})

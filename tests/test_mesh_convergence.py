@@ -151,6 +151,18 @@ def test_runs_relaxing_to_different_rests_are_not_one_relaxation():
     assert 14.88 < r["rest"] < 15.07 and r["rms"] < 0.0045
 
 
+def test_a_run_still_on_a_straight_line_fixes_no_rest_of_its_own():
+    # S11 from above at 0.07-0.24 transits: a steady fall, no curvature to read a rest from
+    above, below = np.arange(6, 20) * 0.012, np.arange(2, 10) * 0.012
+    runs = [(above, 15.42 - 1.8 * (above - above[0])),
+            (below, _relaxing(below, 14.86, rest=14.88, tau=0.03))]
+    r = rest_value(runs)
+    assert r["runs"][0]["alone"]["fixed"] is False
+    assert r["runs"][1]["alone"]["fixed"] is True
+    assert r["runs"][1]["alone"]["rest"] == pytest.approx(14.88, abs=1e-4)
+    assert r["consistent"] is None                    # one own rest: nothing to compare
+
+
 def test_one_run_that_got_there_gives_its_rest_and_no_bracket():
     t = np.arange(5, 92) * 0.012
     r = rest_value([(t, _relaxing(t, 15.3, rest=14.87, tau=0.2))])
