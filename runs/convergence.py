@@ -205,9 +205,9 @@ def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0
     Where there is more than one run, each run with at least four writes is also fitted
     alone. A run fixes a rest of its own ("fixed") when its relaxation time comes out to
     better than half of itself and the run spans at least half of it: a run that is still
-    on a straight line, whose curve gives no rest, does not. The joint
-    fit is ``consistent`` when the own rests of the runs that fix one agree within twice
-    their combined standard deviation (and a relative 1e-6, the fit's own precision): one
+    on a straight line, whose curve gives no rest, does not. The joint fit is
+    ``consistent`` when the own rests of the runs that fix one agree within twice their
+    combined standard deviation (and a relative 1e-6, the fit's own precision): one
     relaxation describes them all. With fewer than two such runs that is not known (None),
     and the joint rest stands on the model alone.
 
