@@ -3,7 +3,7 @@ state per resolution level, with the flow-pattern metrics each level gives.
 
     python bench/case_bench.py [--levels coarse medium fine] [--speed 0.008]
         [--supply layers --layer 2e-6 --track 3e-4] [--jobs 2] [--wall-limit 3600]
-        [--sequence] [--start-from LEVEL|CASE|STATE.npz] [--procs N] [--set KEY=VALUE ...]
+        [--sequence] [--start-from LEVEL|CASE|FILE.npz] [--procs N] [--set KEY=VALUE ...]
         [--collect]
 
 Each level runs serially (one core; ``--procs`` ranks with mpirun); ``--jobs`` runs levels side
@@ -64,8 +64,8 @@ def one(level: str, args: argparse.Namespace, previous: str | None = None) -> di
 def start_case(folder: Path, given: str) -> str:
     """What ``--start-from`` names, as :func:`one` joins it to the tag's ``folder``: a level
     already run there (a sibling case) if there is one of that name, else the path ``given``
-    (relative to the working directory) of any finished case or thin-film state (.npz),
-    made absolute."""
+    (relative to the working directory) of any finished case, case snapshot or thin-film
+    state (.npz), made absolute."""
     if (folder / given).is_dir() or not Path(given).exists():
         return given
     return str(Path(given).resolve())
@@ -93,11 +93,12 @@ def main(argv=None) -> int:
     ap.add_argument("--sequence", action="store_true",
                     help="each level starts from the previous level's final fields")
     ap.add_argument("--procs", type=int, default=1, help="MPI ranks per case")
-    ap.add_argument("--start-from", default=None, metavar="LEVEL|CASE|STATE.npz",
+    ap.add_argument("--start-from", default=None, metavar="LEVEL|CASE|FILE.npz",
                     help="the first level starts from the final fields of LEVEL, already run "
                          "under --tag (grid sequencing without re-running LEVEL), or of the "
                          "finished case at the path CASE (another tag, another mesh), or "
-                         "the oil of the thin-film state CASE.npz")
+                         "of a case snapshot FILE.npz (`ehlfoam snapshot`), or the oil of "
+                         "the thin-film state FILE.npz")
     ap.add_argument("--collect", action="store_true",
                     help="only tabulate the levels already run under --tag")
     ap.add_argument("--set", action="append", default=[], type=spec_option, metavar="KEY=VALUE",

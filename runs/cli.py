@@ -6,6 +6,7 @@ Subcommands:
   case     write an OpenFOAM case from a TOML case spec
   run      run a case to steady state and write its metrics.json
   band     bands of finer cells along a run's meniscus (for mesh.refine)
+  snapshot a run case's state in one small file, to start other cases from
   report   an HTML report (pictures, plots, metrics) of a case or a batch
   batch    generate, run and report a batch of cases (sweeps, speed ramps)
 
@@ -20,7 +21,7 @@ import sys
 from collections.abc import Sequence
 
 from ehl_precalc import cli as precalc_cli
-from runs import batch_cli, meniscus_band
+from runs import batch_cli, case_snapshot, meniscus_band
 from runs.report import add_parser as _report_add_parser
 from runs.foam_runtime import (
     FoamConfigError,
@@ -199,10 +200,11 @@ def build_parser() -> argparse.ArgumentParser:
                            "--set mesh.resolution=coarse; none clears an optional key, e.g. "
                            "--set mesh.polar_radius=none (repeatable)")
     case.add_argument("--overwrite", action="store_true", help="replace an existing case")
-    case.add_argument("--start-from", default=None, metavar="CASE|STATE.npz",
+    case.add_argument("--start-from", default=None, metavar="CASE|SNAPSHOT.npz|STATE.npz",
                       help="start from the final fields of another run case (a converged "
                            "neighbour: another speed, supply or level), copied on the same "
-                           "mesh, else interpolated; or from the oil of a thin-film state "
+                           "mesh, else interpolated; from a case snapshot (`ehlfoam "
+                           "snapshot`); or from the oil of a thin-film state "
                            "(bench/thin_film_region.py writes them)")
     case.set_defaults(func=cmd_case)
 
@@ -222,6 +224,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.set_defaults(func=cmd_run)
 
     meniscus_band.add_parser(sub)
+    case_snapshot.add_parser(sub)
     _report_add_parser(sub)
     batch_cli.add_parser(sub)
     return parser

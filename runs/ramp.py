@@ -30,7 +30,7 @@ from foamlib import FoamFieldFile
 from ehl_precalc.outputs import atomic_write_json
 from generator.case_writer import META, load_geometry
 
-from .case_fields import time_folders
+from .case_fields import Structure, time_folders
 from .field_mapping import LayeredMesh, interpolate
 
 #: The fields a ramp step takes over (internal values only) when its 0.orig/ has them:
@@ -40,6 +40,12 @@ FIELDS = ("alpha.oil", "U", "p_rgh", "p", "T")
 #: centroid moves sideways by ~1e-4 a when the gap above it changes by nanometres (measured
 #: 6e-5 a between 10 and 20 mm/s); the smallest cells are 0.055 a (fine level).
 SAME_MESH_TOL = 1e-3
+
+
+#: The largest median difference between a start's gaps (a thin-film state's, a snapshot's)
+#: and a case's, relative to the case's: a start of the same contact differs by its
+#: sampling only (under 1 %), one of another load or radius by tens of per cent.
+GAP_TOLERANCE = 0.05
 
 
 class RampError(RuntimeError):
@@ -139,14 +145,36 @@ def write_seed(case: Path, fields: dict[str, Any], info: dict[str, Any]) -> dict
     return info
 
 
+def check_same_gap(their_gap: np.ndarray, s: Structure, source: str | Path) -> None:
+    """Raise :class:`RampError` when ``their_gap`` [m] (a start's gaps at the case's
+    columns, NaN where it has none) differs from the case's own columns' gaps (their volume
+    over their footprint) by more than :data:`GAP_TOLERANCE` (median relative difference
+    over the columns it covers): a start of another contact."""
+    gap = np.bincount(s.base_cell, s.cell_volumes) / s.footprint
+    on = np.isfinite(their_gap)
+    diff = float(np.median(np.abs(their_gap[on] / gap[on] - 1.0))) if on.any() else np.inf
+    if not diff <= GAP_TOLERANCE:
+        raise RampError(f"{source}: its gaps differ from the case's by {diff:.1%} (median over "
+                        f"the columns it covers; at most {GAP_TOLERANCE:.0%}): a start of "
+                        "another contact (load, radius or oil)?")
+
+
 def is_thin_film_state(source: str | Path) -> bool:
-    """True when ``source`` names a thin-film state (``.npz``) rather than a run case."""
-    return Path(source).suffix == ".npz"
+    """True when ``source`` names a thin-film state (a ``.npz`` that is no case snapshot)
+    rather than a run case or a snapshot (:mod:`.case_snapshot`)."""
+    from .case_snapshot import is_snapshot
+
+    return Path(source).suffix == ".npz" and not is_snapshot(source)
 
 
 def check_start(source: str | Path) -> None:
     """Raise :class:`RampError` (or OSError) unless ``source`` can start a case: a run case
-    with a written time, or a readable thin-film state. Call it before writing anything."""
+    with a written time, a case snapshot, or a readable thin-film state. Call it before
+    writing anything."""
+    from .case_snapshot import is_snapshot
+
+    if is_snapshot(source):
+        return
     if not is_thin_film_state(source):
         final_time(source)
         return
@@ -160,8 +188,13 @@ def check_start(source: str | Path) -> None:
 
 
 def seed_case(case: str | Path, source: str | Path) -> dict[str, Any]:
-    """Start ``case`` from ``source``: a run case's final fields (:func:`seed_from_previous`)
-    or a thin-film state's oil (:func:`runs.thin_film_seed.seed_from_thin_film`)."""
+    """Start ``case`` from ``source``: a run case's final fields (:func:`seed_from_previous`),
+    a case snapshot's (:func:`runs.case_snapshot.seed_from_snapshot`) or a thin-film state's
+    oil (:func:`runs.thin_film_seed.seed_from_thin_film`)."""
+    from .case_snapshot import is_snapshot, seed_from_snapshot
+
+    if is_snapshot(source):
+        return seed_from_snapshot(case, source)
     if is_thin_film_state(source):
         from .thin_film_seed import seed_from_thin_film
 

@@ -25,27 +25,7 @@ from generator.case_writer import wall_layers_fraction
 
 from .case_fields import Structure
 from .field_mapping import relative_heights
-from .ramp import RampError, write_seed
-
-
-#: The largest median difference between a thin-film state's gaps and a case's, relative to
-#: the case's: a state of the same contact differs by its grid's sampling only (under 1 %),
-#: one of another load or radius by tens of per cent.
-GAP_TOLERANCE = 0.05
-
-
-def check_same_gap(sol: ThinFilmSolution, s: Structure, state: Path) -> None:
-    """Raise :class:`RampError` when the state's gaps [m] differ from the case's columns'
-    (their volume over their footprint) by more than :data:`GAP_TOLERANCE` (median over
-    the columns on the state's grid): a state of another contact."""
-    gap = np.bincount(s.base_cell, s.cell_volumes) / s.footprint
-    mine = _state_gap(sol, s.base_x, s.base_y)
-    on = np.isfinite(mine)
-    diff = float(np.median(np.abs(mine[on] / gap[on] - 1.0))) if on.any() else np.inf
-    if not diff <= GAP_TOLERANCE:
-        raise RampError(f"{state}: its gaps differ from the case's by {diff:.1%} (median over "
-                        f"the columns it covers; at most {GAP_TOLERANCE:.0%}): a state of "
-                        "another contact (load, radius or oil)?")
+from .ramp import check_same_gap, write_seed
 
 
 def _state_gap(sol: ThinFilmSolution, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -70,7 +50,7 @@ def seed_from_thin_film(case: str | Path, state: str | Path) -> dict[str, Any]:
     sol = load_state(state)
     s = Structure.load(case)
     column = sol.oil_fraction_at(s.base_x, s.base_y)
-    check_same_gap(sol, s, state)
+    check_same_gap(_state_gap(sol, s.base_x, s.base_y), s, state)
     phi = column[s.base_cell]
     lo, hi = relative_heights(s)
     path = case / "0.orig" / "alpha.oil"

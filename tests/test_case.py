@@ -748,6 +748,56 @@ def test_cli_case_starts_from_another_run_case(tmp_path):
         start, case_fields._read_alpha(first / "0.orig" / "alpha.oil", structure)[0])
 
 
+def test_cli_snapshot_keeps_a_runs_state_and_starts_another_case_from_it(tmp_path):
+    """`ehlfoam snapshot CASE OUT.npz`: a run's last write in one small file; `ehlfoam case
+    --start-from OUT.npz` gives a case on the same mesh that write's oil and velocity back
+    (to 16 bits and half precision), and the case runs. A case with nothing written, a file
+    name that is no .npz and a snapshot of another contact are refused, naming the cause."""
+    spec = tmp_path / "small.toml"
+    spec.write_text(_toml({**SMALL, "run": {**SMALL["run"], "end_time": 2e-4}}))
+    first, second, other = tmp_path / "first", tmp_path / "second", tmp_path / "other"
+    snap = tmp_path / "first.npz"
+    assert subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(first)],
+                          capture_output=True).returncode == 0
+    refused = subprocess.run([*EHLFOAM, "snapshot", str(first), str(snap)],
+                             capture_output=True, text=True)
+    assert refused.returncode == 2 and "no written time" in refused.stderr
+    assert run_case(first, wall_limit=120)["status"] == "finished"
+    refused = subprocess.run([*EHLFOAM, "snapshot", str(first), str(tmp_path / "first.txt")],
+                             capture_output=True, text=True)
+    assert refused.returncode == 2 and "must end in .npz" in refused.stderr
+    assert not (tmp_path / "first.txt").exists()
+    proc = subprocess.run([*EHLFOAM, "snapshot", str(first), str(snap)],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "alpha.oil, U" in proc.stdout and snap.is_file()
+
+    proc = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(second), "--start-from",
+                           str(snap)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    t, folder = case_fields.time_folders(first)[-1]
+    info = json.loads((second / "ehlfoam" / "ramp.json").read_text())
+    assert info["method"] == "snapshot" and info["fields"] == ["U", "alpha.oil"]
+    assert info["previous_time_s"] == pytest.approx(t)
+    s = case_fields.Structure.load(second)
+    final = case_fields._read_alpha(folder / "alpha.oil", s)[0]
+    start = case_fields._read_alpha(second / "0.orig" / "alpha.oil", s)[0]
+    assert final.min() < 0.5 < final.max()                    # an interface to carry
+    assert np.abs(start - final).max() < 2e-5
+    assert s.cell_volumes @ start == pytest.approx(s.cell_volumes @ final, rel=1e-5)
+    u_final = np.asarray(FoamFieldFile(folder / "U").internal_field)
+    u_start = np.asarray(FoamFieldFile(second / "0.orig" / "U").internal_field)
+    assert np.abs(u_final).max() > 0.1 * SMALL["contact"]["speed"]
+    assert np.abs(u_start - u_final).max() < 2e-3 * np.abs(u_final).max()
+    assert run_case(second, wall_limit=120)["status"] == "finished"
+
+    refused = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(other), "--start-from",
+                              str(snap), "--set", "contact.load=60"],
+                             capture_output=True, text=True)
+    assert refused.returncode == 2 and "its gaps differ from the case's" in refused.stderr
+    assert not other.exists()
+
+
 def _thin_film_state(path: Path, a: float, films: float, gap_factor: float = 1.0) -> None:
     """A thin-film state written by hand on 0.25 a cells over x = -2..4 a, y = 0..2 a of the
     small case's gap (times ``gap_factor``): flooded ahead of x = a, films of ``films`` of the

@@ -1,0 +1,207 @@
+"""A run case's state in one small file, to start other cases from (``ehlfoam snapshot``).
+
+A run folder holds its mesh and every written time, tens to hundreds of MB, and run folders
+are not part of the repository: a study that runs for hours over several sessions or machines
+loses its states with the folder. What another case needs to go on from a write is the oil
+(alpha.oil) and the velocity (U) there, and enough of the mesh to interpolate them layer by
+layer (:class:`~runs.field_mapping.LayeredMesh`: each column's centre and its layers' relative
+heights). A snapshot stores those per column and layer in a compressed ``.npz``: the oil
+fraction and the heights to 1.5e-5 (16-bit), the velocity in half precision (1e-3 relative),
+each column's gap [m], which tells a snapshot of another contact, and a record of where it
+came from (the case, the time, its spec and its history.csv, so that a study can go on
+reading the run's history). The pressure is not kept: interFoam solves it afresh at every
+step, and in this Stokes flow the velocity follows within a few steps.
+
+    ehlfoam snapshot CASE OUT.npz [--time last|TRANSITS] [--fields alpha.oil U]
+    ehlfoam case SPEC --out NEW --start-from OUT.npz
+
+A snapshot of a 66,060-cell case (20 layers) takes 0.51 MB, 0.14 MB with alpha.oil alone, and
+2 s to write.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from foamlib import FoamFieldFile
+
+from ehl_precalc.outputs import atomic_write
+from generator.case_writer import META, load_geometry
+
+from .case_fields import Structure, time_folders, write_near
+from .field_mapping import LayeredMesh, interpolate
+from .ramp import check_same_gap, write_seed
+
+#: The ``kind`` entry that tells a snapshot from a thin-film state (both are .npz).
+KIND = "ehlfoam-case-snapshot"
+#: The fields a snapshot may keep; alpha.oil always.
+FIELDS = ("alpha.oil", "U")
+_SCALE = 65535.0   # 16-bit fractions in [0, 1]
+
+
+class SnapshotError(ValueError):
+    """A snapshot cannot be written or read; the message names what is wrong."""
+
+
+def is_snapshot(path: str | Path) -> bool:
+    """True when ``path`` is a readable ``.npz`` written by :func:`save_snapshot`."""
+    try:
+        with np.load(path, allow_pickle=False) as d:
+            return "kind" in d.files and str(d["kind"]) == KIND
+    except (OSError, ValueError, EOFError):
+        return False
+
+
+def _columns(s: Structure) -> tuple[int, int]:
+    """(columns, layers) of a case whose every column has the same layers, else raise."""
+    n_base, n_layers = len(s.base_x), int(s.layer.max()) + 1
+    if len(s.base_cell) != n_base * n_layers:
+        raise SnapshotError(f"the mesh has {len(s.base_cell)} cells, not {n_base} columns of "
+                            f"{n_layers} layers: not a layered gap mesh")
+    return n_base, n_layers
+
+
+def save_snapshot(case: str | Path, path: str | Path, at: str = "last",
+                  fields: tuple[str, ...] = FIELDS) -> dict[str, Any]:
+    """Write the fields of ``case``'s write nearest ``at`` transits ("last": its last write)
+    to ``path`` (a compressed .npz, written atomically). Returns the snapshot's record:
+    {"source", "time_s", "transits", "cells", "fields", "spec", "history"}."""
+    case, path = Path(case), Path(path)
+    if path.suffix != ".npz":
+        raise SnapshotError(f"snapshot file = {str(path)!r} must end in .npz")
+    unknown = [f for f in fields if f not in FIELDS]
+    if unknown or "alpha.oil" not in fields:
+        raise SnapshotError(f"fields = {list(fields)}: a snapshot keeps alpha.oil and "
+                            f"optionally U (valid: {', '.join(FIELDS)})")
+    geom = load_geometry(case)
+    s = Structure.load(case)
+    n_base, n_layers = _columns(s)
+    t, folder, values = _read_write(case, at, geom.transit_time, fields, len(s.base_cell))
+    mesh = LayeredMesh.load(case)
+    arrays: dict[str, np.ndarray] = {
+        "kind": np.array(KIND),
+        "base_xy": mesh.base_xy.astype(np.float32),
+        "zeta": _fraction16(mesh.zeta_columns()),
+        "gap": (np.bincount(s.base_cell, s.cell_volumes) / s.footprint).astype(np.float32),
+    }
+    for name, value in values.items():
+        columns = mesh.columns(value)
+        arrays[name] = (_fraction16(np.clip(columns, 0.0, 1.0)) if name == "alpha.oil"
+                        else columns.astype(np.float16))
+    spec = case / META / "spec.json"
+    history = case / "history.csv"
+    record = {"source": str(case), "time_s": t, "transits": t / geom.transit_time,
+              "cells": len(s.base_cell), "columns": n_base, "layers": n_layers,
+              "fields": list(fields),
+              "spec": json.loads(spec.read_text()) if spec.is_file() else None,
+              "history": history.read_text() if history.is_file() else None}
+    arrays["record"] = np.array(json.dumps(record))
+    atomic_write(path, lambda fh: np.savez_compressed(fh, **arrays))
+    return record
+
+
+def _read_write(case: Path, at: str, transit_time: float, fields: tuple[str, ...],
+                n: int) -> tuple[float, Path, dict[str, np.ndarray]]:
+    """(time [s], folder, fields per cell) of the write nearest ``at`` transits; for "last"
+    the one before it when the last cannot be read whole (a running case may be writing it)."""
+    t, folder = write_near(case, at, transit_time)
+    tries = [(t, folder)]
+    if at == "last":
+        tries += [tf for tf in time_folders(case) if tf[0] < t][-1:]
+    for i, (t, folder) in enumerate(tries):
+        try:
+            values = {}
+            for name in fields:
+                value = np.asarray(FoamFieldFile(folder / name).internal_field, dtype=float)
+                shape = (n, 3) if name == "U" else (n,)
+                values[name] = np.broadcast_to(value, shape)        # uniform or a list
+            return t, folder, values
+        except (OSError, ValueError) as err:
+            if i == len(tries) - 1:
+                raise SnapshotError(f"{folder}: cannot read {name} ({err})") from None
+    raise AssertionError("unreachable")
+
+
+def _fraction16(values: np.ndarray) -> np.ndarray:
+    return np.rint(np.asarray(values) * _SCALE).astype(np.uint16)
+
+
+def load_snapshot(path: str | Path) -> tuple[LayeredMesh, np.ndarray, dict[str, np.ndarray],
+                                             dict[str, Any]]:
+    """(mesh, column gaps [m], fields per cell, record) of a snapshot file; raises
+    :class:`SnapshotError` for a file that is none."""
+    if not is_snapshot(path):
+        raise SnapshotError(f"{path} is not a case snapshot written by `ehlfoam snapshot`")
+    with np.load(path, allow_pickle=False) as d:
+        base_xy = d["base_xy"].astype(float)
+        zeta = d["zeta"].astype(float) / _SCALE
+        n_base, n_layers = zeta.shape
+        base_cell = np.repeat(np.arange(n_base), n_layers)
+        layer = np.tile(np.arange(n_layers), n_base)
+        mesh = LayeredMesh(base_cell, layer, zeta.ravel(), base_xy)
+        fields = {}
+        for name in FIELDS:
+            if name in d.files:
+                v = d[name].astype(float)
+                fields[name] = (v / _SCALE).ravel() if name == "alpha.oil" else v.reshape(-1, 3)
+        return mesh, d["gap"].astype(float), fields, json.loads(str(d["record"]))
+
+
+def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]:
+    """Write a snapshot's fields as ``case``'s initial fields (its ``0.orig/``), interpolated
+    layer by layer onto its mesh (:mod:`.field_mapping`; the same mesh gets its own values
+    back, to the snapshot's precision). Returns (and writes to ``case/ehlfoam/ramp.json``)
+    {"previous", "previous_time_s", "method": "snapshot", "fields", "cells", "source"}."""
+    case, snapshot = Path(case).absolute(), Path(snapshot).absolute()
+    source, their_gap, fields, record = load_snapshot(snapshot)
+    target = LayeredMesh.load(case)
+    s = Structure.load(case)
+    gap_at = interpolate(their_gap[source.base_cell], source, target)
+    check_same_gap(s.gap_mean(gap_at), s, snapshot)
+    out = {}
+    for name, value in fields.items():
+        if not (case / "0.orig" / name).is_file():
+            continue
+        mapped = interpolate(value, source, target)
+        out[name] = np.clip(mapped, 0.0, 1.0) if name == "alpha.oil" else mapped
+    return write_seed(case, out, {
+        "previous": os.path.relpath(snapshot, case), "previous_time_s": record["time_s"],
+        "method": "snapshot", "fields": sorted(out), "source": record["source"]})
+
+
+def history_of(snapshot: str | Path) -> str | None:
+    """The history.csv text of the run a snapshot was taken from (None if it had none)."""
+    return load_snapshot(snapshot)[3]["history"]
+
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("snapshot", help="a run case's state in one small file (--start-from)",
+                       description=__doc__.split("\n\n")[0])
+    p.add_argument("case", type=Path)
+    p.add_argument("out", type=Path, help="the snapshot file to write (.npz)")
+    p.add_argument("--time", default="last",
+                   help="transits of the write to keep, or 'last' (default)")
+    p.add_argument("--fields", nargs="+", default=list(FIELDS), choices=FIELDS,
+                   help="fields to keep (alpha.oil always; U makes the file some 4 times "
+                        "larger and the first steps calmer)")
+    p.set_defaults(func=cmd_snapshot)
+
+
+def cmd_snapshot(args: argparse.Namespace) -> int:
+    try:
+        record = save_snapshot(args.case, args.out, args.time, tuple(args.fields))
+    except (SnapshotError, ValueError, OSError) as err:
+        print(f"ehlfoam snapshot: {err}", file=sys.stderr)
+        return 2
+    size = args.out.stat().st_size
+    print(f"snapshot {args.out}: {record['source']} at t = {record['time_s']:.6g} s "
+          f"({record['transits']:.4f} transits), {record['cells']} cells, "
+          f"{', '.join(record['fields'])}, {size / 1e6:.2f} MB")
+    return 0
