@@ -9,7 +9,9 @@ run fitted alone says whether one relaxation fits them all.
         [--rate-window W] [--save NAME.json] [--note TEXT]
 
 ``CASE@T0`` reads that run from T0 transits on (to leave out the start, where a mapped state
-settles on its new mesh). Times are each run's own, in transits. Writes
+settles on its new mesh). Times are each run's own, in transits. A CASE may also be a case
+snapshot (``ehlfoam snapshot``): the run's history up to it, so that a run whose folder is
+gone, or which another case continues from the snapshot, still counts. Writes
 ``bench/results/NAME.json`` (default rest_value.json).
 """
 
@@ -27,15 +29,20 @@ sys.path.insert(0, str(ROOT))
 from bench.common import save  # noqa: E402
 from bench.plot_midgap import _pick  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
+from runs.case_snapshot import is_snapshot, snapshot_history  # noqa: E402
 from runs.convergence import METRICS, rest_value  # noqa: E402
 from runs.report.case_data import read_history  # noqa: E402
 
 
 def series(case: Path, key: str, t0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """(times [transits], values) of ``key`` in the case's history.csv from ``t0`` transits on,
-    leaving out writes where the metric is undefined."""
-    history = read_history(case / "history.csv")
-    t, f = history["time_s"] / load_geometry(case).transit_time, history[key]
+    """(times [transits], values) of ``key`` in the case's history.csv (or in the history a
+    case snapshot kept, ``ehlfoam snapshot``) from ``t0`` transits on, leaving out writes
+    where the metric is undefined."""
+    if is_snapshot(case):
+        history, transit = snapshot_history(case)
+    else:
+        history, transit = read_history(case / "history.csv"), load_geometry(case).transit_time
+    t, f = history["time_s"] / transit, history[key]
     keep = np.isfinite(f) & (t >= t0 - 1e-9)
     return t[keep], f[keep]
 
@@ -51,8 +58,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     cases = [(case, t0 or 0.0) for case, t0 in map(_pick, args.cases)]
     for case, _ in cases:
-        if not (case / "history.csv").is_file():
-            ap.error(f"cases: {case} has no history.csv (run it first)")
+        if not ((case / "history.csv").is_file() or is_snapshot(case)):
+            ap.error(f"cases: {case} has no history.csv (run it first) and is no case snapshot")
     out = {}
     for key in args.metrics:
         runs = [series(case, key, t0) for case, t0 in cases]
@@ -63,7 +70,8 @@ def main(argv=None) -> int:
         out[key] = r
         print(key)
         for (case, t0), s in zip(cases, r["runs"]):
-            print(f"  {case.parent.name:42s} from {s['t_first']:.3f} to {s['t_last']:.3f} "
+            label = case.stem if is_snapshot(case) else case.parent.name
+            print(f"  {label:42s} from {s['t_first']:.3f} to {s['t_last']:.3f} "
                   f"transits ({s['writes']} writes): {s['first']:.3f} -> {s['last']:.3f}, "
                   f"{s['rate']:+.3f} a transit at the end")
             if s["alone"] is not None:

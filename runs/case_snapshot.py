@@ -175,11 +175,22 @@ def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]
         "method": "snapshot", "fields": sorted(out), "source": record["source"]})
 
 
-def history_of(snapshot: str | Path) -> str | None:
-    """The history.csv text of the run a snapshot was taken from (None if it had none)."""
-    return load_snapshot(snapshot)[3]["history"]
+def snapshot_history(snapshot: str | Path) -> tuple[dict[str, np.ndarray], float]:
+    """(history columns, transit time [s]) of the run a snapshot was taken from, its
+    history.csv up to the snapshot's write as :func:`runs.report.case_data.read_history`
+    reads it; raises :class:`SnapshotError` when it kept none."""
+    import csv
+    import io
 
+    from .report.case_data import history_columns
 
+    record = load_snapshot(snapshot)[3]
+    columns = (history_columns(list(csv.DictReader(io.StringIO(record["history"]))))
+               if record["history"] else None)
+    if columns is None or record["transits"] <= 0.0:
+        raise SnapshotError(f"{snapshot}: its run kept no history.csv")
+    keep = columns["time_s"] <= record["time_s"] * (1.0 + 1e-9)
+    return {k: v[keep] for k, v in columns.items()}, record["time_s"] / record["transits"]
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("snapshot", help="a run case's state in one small file (--start-from)",

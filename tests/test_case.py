@@ -771,6 +771,12 @@ def test_cli_snapshot_keeps_a_runs_state_and_starts_another_case_from_it(tmp_pat
                           capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert "alpha.oil, U" in proc.stdout and snap.is_file()
+    from bench.rest_value import series       # the run's history rides along
+    for key in ("oil_volume_m3", "flooded_width_over_a"):
+        kept, own = series(snap, key), series(first, key)
+        assert len(own[0]) > 0
+        np.testing.assert_allclose(kept[0], own[0])
+        np.testing.assert_allclose(kept[1], own[1])
 
     proc = subprocess.run([*EHLFOAM, "case", str(spec), "--out", str(second), "--start-from",
                            str(snap)], capture_output=True, text=True)

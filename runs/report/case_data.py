@@ -124,9 +124,14 @@ def read_history(path: Path) -> dict[str, np.ndarray] | None:
     booleans (None for empty cells), so that a written "False" does not read as true."""
     try:
         with open(path, newline="") as fh:
-            rows = list(csv.DictReader(fh))
+            return history_columns(list(csv.DictReader(fh)))
     except FileNotFoundError:
         return None
+
+
+def history_columns(rows: list[dict[str, str]]) -> dict[str, np.ndarray] | None:
+    """The rows of a history.csv (``csv.DictReader``'s) as :func:`read_history`'s columns;
+    None for no rows."""
     if not rows:
         return None
     out: dict[str, np.ndarray] = {}
