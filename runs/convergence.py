@@ -193,6 +193,15 @@ def _relaxation_fit(runs: list[tuple[np.ndarray, np.ndarray]]) -> dict:
             "tau_sd": float(sd[1]), "rms": float(np.sqrt(np.sum(fit.fun ** 2) / n))}
 
 
+def fixes_a_rest(fit: dict, span: float) -> bool:
+    """True when a relaxation fit (:func:`rest_value`'s "rest", "rest_sd", "tau", "tau_sd")
+    of runs spanning ``span`` transits fixes its rest: its relaxation time comes out to better
+    than half of itself and the runs span at least half of it. A run still on a straight
+    line, whose curve gives no rest, does not."""
+    return bool(math.isfinite(fit["rest_sd"]) and fit["tau_sd"] < 0.5 * fit["tau"]
+                and fit["tau"] <= 2 * span)
+
+
 def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0.036) -> dict:
     """The value a metric comes to rest at on one mesh, read off runs that approach it (say one
     from above and one from below) before any of them gets there.
@@ -230,9 +239,7 @@ def rest_value(runs: list[tuple[np.ndarray, np.ndarray]], rate_window: float = 0
         alone = None
         if len(runs) > 1 and len(t) >= 4:
             alone = _relaxation_fit([(t, f)])
-            alone["fixed"] = bool(math.isfinite(alone["rest_sd"])
-                                  and alone["tau_sd"] < 0.5 * alone["tau"]
-                                  and alone["tau"] <= 2 * (t[-1] - t[0]))
+            alone["fixed"] = fixes_a_rest(alone, t[-1] - t[0])
         summary.append({"first": float(f[0]), "last": float(f[-1]), "t_first": float(t[0]),
                         "t_last": float(t[-1]), "rate": rate, "writes": int(len(t)),
                         "alone": alone})

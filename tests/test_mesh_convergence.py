@@ -195,3 +195,23 @@ def test_rest_value_bench_reads_two_histories(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "rest 15.070" in out
     assert width["consistent"] is True and "agree: one relaxation fits them all" in out
+
+
+def test_rest_chart_draws_brackets_and_leaves_out_undetermined_fits(tmp_path, capsys):
+    """bench/rest_chart.py: a record per mesh as rest_value.py writes it; a fit whose
+    relaxation time is not determined is not drawn and says so."""
+    from bench.rest_chart import determined, main as chart_main
+
+    above, below = np.arange(1, 16) * 0.012, np.arange(1, 17) * 0.012
+    two = rest_value([(above, _relaxing(above, 15.45)), (below, _relaxing(below, 14.86))])
+    line = np.arange(6, 20) * 0.012
+    straight = rest_value([(line, 15.42 - 1.8 * (line - line[0]))])
+    assert determined(two) and not determined(straight)
+    for name, r in (("two.json", two), ("straight.json", straight)):
+        (tmp_path / name).write_text(json.dumps({"metrics": {"flooded_width_over_a": r}}))
+    png = tmp_path / "chart.png"
+    assert chart_main([f"{tmp_path / 'two.json'}@0.06", f"{tmp_path / 'straight.json'}@0.03",
+                       "--metrics", "flooded_width_over_a", "--out", str(png)]) == 0
+    out = capsys.readouterr().out
+    assert "0.06: fit 15.070 +- 0.000, bracket" in out and "0.03: fit not determined" in out
+    assert png.stat().st_size > 10_000
