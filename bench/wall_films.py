@@ -60,8 +60,7 @@ def films(case: Path) -> dict:
         sel = st.layer == layer
         wall[name] = np.bincount(st.base_cell[sel], alpha[sel], minlength=n)
     x, y = st.base_x / geom.a, np.abs(st.base_y) / geom.a
-    wall_share = st.wall_cell / (np.bincount(st.base_cell, st.cell_volumes, minlength=n)
-                                 / st.footprint)       # the wall cell over the column's gap
+    wall_share = st.wall_cell / st.column_gaps()   # the wall cell over the column's gap
     out = {"case": str(case), "cells": geom.cells,
            "wall_cell_over_gap": float(np.median(wall_share)),
            "landau_levich_both_walls_over_gap": landau_levich(
@@ -95,8 +94,7 @@ def rear_films(case: Path, bins: list[tuple[float, float]] = ((1.0, 2.0),),
     that gap, over Landau-Levich's both films together (module docstring)."""
     geom, spec = load_geometry(case), load_spec_of(case)
     st = case_fields.Structure.load(case)
-    n = len(st.base_x)
-    gap = np.bincount(st.base_cell, st.cell_volumes, minlength=n) / st.footprint
+    gap = st.column_gaps()
     x, y = st.base_x / geom.a, np.abs(st.base_y) / geom.a
     axis = y < AXIS_HALF_WIDTH
     ll = landau_levich(spec.oil_viscosity, spec.speed, spec.physics.surface_tension)

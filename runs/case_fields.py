@@ -57,6 +57,12 @@ class Structure:
         area[base[on_disc]] = d["cell_volumes"][on_disc] / wall[base[on_disc]]
         return cls(d["cell_volumes"], base, d["layer"], bx, by, patches, wall, area)
 
+    def column_gaps(self) -> np.ndarray:
+        """Per base cell, the gap across its column [m]: the column's volume over its
+        footprint."""
+        return np.bincount(self.base_cell, self.cell_volumes, minlength=len(self.base_x)) \
+            / self.footprint
+
     def gap_mean(self, field: np.ndarray) -> np.ndarray:
         """Per base cell, the volume-weighted mean of a cell field over the column across the
         gap (a scalar field gives shape (n_base,), a vector field (n_base, k))."""

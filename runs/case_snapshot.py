@@ -88,7 +88,7 @@ def save_snapshot(case: str | Path, path: str | Path, at: str = "last",
         "kind": np.array(KIND),
         "base_xy": mesh.base_xy.astype(np.float32),
         "zeta": _fraction16(mesh.zeta_columns()),
-        "gap": (np.bincount(s.base_cell, s.cell_volumes) / s.footprint).astype(np.float32),
+        "gap": s.column_gaps().astype(np.float32),
     }
     for name, value in values.items():
         columns = mesh.columns(value)
@@ -110,22 +110,17 @@ def _read_write(case: Path, at: str, transit_time: float, fields: tuple[str, ...
                 n: int) -> tuple[float, Path, dict[str, np.ndarray]]:
     """(time [s], folder, fields per cell) of the write nearest ``at`` transits; for "last"
     the one before it when the last cannot be read whole (a running case may be writing it)."""
-    t, folder = write_near(case, at, transit_time)
-    tries = [(t, folder)]
+    tries = [write_near(case, at, transit_time)]
     if at == "last":
-        tries += [tf for tf in time_folders(case) if tf[0] < t][-1:]
-    for i, (t, folder) in enumerate(tries):
+        tries += [tf for tf in time_folders(case) if tf[0] < tries[0][0]][-1:]
+    for t, folder in tries:
         try:
-            values = {}
-            for name in fields:
-                value = np.asarray(FoamFieldFile(folder / name).internal_field, dtype=float)
-                shape = (n, 3) if name == "U" else (n,)
-                values[name] = np.broadcast_to(value, shape)        # uniform or a list
-            return t, folder, values
+            return t, folder, {name: np.broadcast_to(   # a uniform value or a list
+                np.asarray(FoamFieldFile(folder / name).internal_field, dtype=float),
+                (n, 3) if name == "U" else (n,)) for name in fields}
         except (OSError, ValueError) as err:
-            if i == len(tries) - 1:
-                raise SnapshotError(f"{folder}: cannot read {name} ({err})") from None
-    raise AssertionError("unreachable")
+            error = f"{folder}: cannot read {', '.join(fields)} ({err})"
+    raise SnapshotError(error)
 
 
 def _fraction16(values: np.ndarray) -> np.ndarray:
@@ -191,6 +186,7 @@ def snapshot_history(snapshot: str | Path) -> tuple[dict[str, np.ndarray], float
         raise SnapshotError(f"{snapshot}: its run kept no history.csv")
     keep = columns["time_s"] <= record["time_s"] * (1.0 + 1e-9)
     return {k: v[keep] for k, v in columns.items()}, record["time_s"] / record["transits"]
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("snapshot", help="a run case's state in one small file (--start-from)",

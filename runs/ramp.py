@@ -150,7 +150,7 @@ def check_same_gap(their_gap: np.ndarray, s: Structure, source: str | Path) -> N
     columns, NaN where it has none) differs from the case's own columns' gaps (their volume
     over their footprint) by more than :data:`GAP_TOLERANCE` (median relative difference
     over the columns it covers): a start of another contact."""
-    gap = np.bincount(s.base_cell, s.cell_volumes) / s.footprint
+    gap = s.column_gaps()
     on = np.isfinite(their_gap)
     diff = float(np.median(np.abs(their_gap[on] / gap[on] - 1.0))) if on.any() else np.inf
     if not diff <= GAP_TOLERANCE:
