@@ -62,9 +62,9 @@ def main(argv=None) -> int:
             ap.error(f"cases: {case} has no history.csv (run it first) and is no case snapshot")
     out = {}
     for key in args.metrics:
-        runs = [series(case, key, t0) for case, t0 in cases]
-        try:
-            r = rest_value(runs, rate_window=args.rate_window)
+        try:   # a snapshot that kept no history, too few writes
+            r = rest_value([series(case, key, t0) for case, t0 in cases],
+                           rate_window=args.rate_window)
         except ValueError as err:
             ap.error(f"{key}: {err}")
         out[key] = r
