@@ -127,12 +127,16 @@ def _fraction16(values: np.ndarray) -> np.ndarray:
     return np.rint(np.asarray(values) * _SCALE).astype(np.uint16)
 
 
+def _require_snapshot(path: str | Path) -> None:
+    if not is_snapshot(path):
+        raise SnapshotError(f"{path} is not a case snapshot written by `ehlfoam snapshot`")
+
+
 def load_snapshot(path: str | Path) -> tuple[LayeredMesh, np.ndarray, dict[str, np.ndarray],
                                              dict[str, Any]]:
     """(mesh, column gaps [m], fields per cell, record) of a snapshot file; raises
     :class:`SnapshotError` for a file that is none."""
-    if not is_snapshot(path):
-        raise SnapshotError(f"{path} is not a case snapshot written by `ehlfoam snapshot`")
+    _require_snapshot(path)
     with np.load(path, allow_pickle=False) as d:
         base_xy = d["base_xy"].astype(float)
         zeta = d["zeta"].astype(float) / _SCALE
@@ -179,7 +183,9 @@ def snapshot_history(snapshot: str | Path) -> tuple[dict[str, np.ndarray], float
 
     from .report.case_data import history_columns
 
-    record = load_snapshot(snapshot)[3]
+    _require_snapshot(snapshot)
+    with np.load(snapshot, allow_pickle=False) as d:   # the record only, not the fields
+        record = json.loads(str(d["record"]))
     columns = (history_columns(list(csv.DictReader(io.StringIO(record["history"]))))
                if record["history"] else None)
     if columns is None or record["transits"] <= 0.0:
