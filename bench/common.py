@@ -51,11 +51,12 @@ def solve_in_subprocess(spec_kwargs: dict, options: dict | None = None) -> dict:
 
 def save(name: str, data) -> Path:
     """Write a record ``bench/results/NAME`` as JSON, atomically (an interrupted script never
-    leaves half a record)."""
+    leaves half a record); ``.json`` is added to a NAME without it, so that every record is
+    found by its suffix."""
     from ehl_precalc.outputs import atomic_write_text
 
     RESULTS.mkdir(exist_ok=True)
-    path = RESULTS / name
+    path = RESULTS / (name if name.endswith(".json") else f"{name}.json")
     atomic_write_text(path, json.dumps(data, indent=2, default=str) + "\n")
     return path
 

@@ -64,3 +64,18 @@ def test_start_from_names_a_level_of_the_tag_or_any_finished_case(tmp_path, monk
     assert (tag / start_case(tag, "elsewhere/fine")).resolve() == other.resolve()
     assert Path(start_case(tag, "elsewhere/fine")).is_absolute()
     assert (tag / start_case(tag, "../../elsewhere/fine")).resolve() == other.resolve()
+
+
+def test_a_record_saved_without_its_suffix_gets_it(tmp_path, monkeypatch):
+    """``bench.common.save`` (the records' writer, beside the edits): a ``--save NAME`` given
+    without ``.json`` still writes ``NAME.json``, which the charts and readers look for."""
+    import json
+
+    import bench.common as common
+
+    monkeypatch.setattr(common, "RESULTS", tmp_path)
+    bare = common.save("outline_run", {"width": 14.868})
+    suffixed = common.save("rest.json", {"width": 14.868})
+    assert bare == tmp_path / "outline_run.json" and suffixed == tmp_path / "rest.json"
+    assert json.loads(bare.read_text()) == {"width": 14.868}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["outline_run.json", "rest.json"]
