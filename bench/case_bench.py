@@ -27,9 +27,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from generator.case_spec import make_case_spec  # noqa: E402
-from generator.case_writer import load_geometry, write_case  # noqa: E402
+from generator.case_writer import load_geometry  # noqa: E402
 from common import apply_edits, foam_edit, solver_cpu_s, spec_option  # noqa: E402
-from runs.ramp import seed_case  # noqa: E402
+from runs.follow_meniscus import write_started_case  # noqa: E402
 from runs.run_case import run_case  # noqa: E402
 
 RESULTS = ROOT / "bench" / "results"
@@ -52,10 +52,9 @@ def one(level: str, args: argparse.Namespace, previous: str | None = None) -> di
                 "n_procs": args.procs}}, **dict(args.set))
     case = Path(args.work) / args.tag / level
     t0 = time.perf_counter()
-    write_case(spec, case, overwrite=True)
+    write_started_case(spec, case, None if previous is None else case.parent / previous,
+                       overwrite=True)   # with mesh.follow, along the source's meniscus
     apply_edits(case, args.edit)
-    if previous is not None:
-        seed_case(case, case.parent / previous)
     build_s = time.perf_counter() - t0
     run_case(case)
     return row_of(case, level, previous, build_s)

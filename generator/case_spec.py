@@ -63,6 +63,29 @@ RESOLUTIONS: dict[str, dict[str, float]] = {
     "fine": {"size_rim": 0.055, "size_far": 0.38, "n_layers": 14, "wall_grading": 12.0},
 }
 
+#: The levels whose mesh follows the start state's meniscus (``mesh.follow``): a band of
+#: in-plane cells of ``band`` (a) along the meniscus, twice as fine on the region's sides
+#: (``mesh.follow.sides``), and one wall cell of ``wall_cell`` [m] everywhere, on the base
+#: cells and layers of :data:`FOLLOW_BASE`. They are the study series S13 / S12 / S11 of
+#: docs/cases.md, over which the inlet meniscus and the flooded width at rest settle within
+#: 2 % and 1 % from the medium level on, where the levels of :data:`RESOLUTIONS` leave the
+#: meniscus in their base cells and the width does not converge ("Resolved levels").
+FOLLOW_LEVELS: dict[str, dict[str, float]] = {
+    "coarse": {"band": 0.24, "wall_cell": 3.2e-6},
+    "medium": {"band": 0.12, "wall_cell": 1.6e-6},
+    "fine": {"band": 0.06, "wall_cell": 0.4e-6},
+}
+
+#: Base cells of the following levels: the coarse level's in-plane sizes (the bands carry the
+#: resolution where the meniscus is) and 20 layers across the gap.
+FOLLOW_BASE: dict[str, float] = {"size_rim": RESOLUTIONS["coarse"]["size_rim"],
+                                 "size_far": RESOLUTIONS["coarse"]["size_far"],
+                                 "n_layers": 20}
+
+#: mesh.polar_radius = "auto" with mesh.follow: the polar ring ends at this radius (a), twice
+#: the default island's, so that the bands (which refine free quads only) reach the meniscus.
+FOLLOW_POLAR_RADIUS = 3.0
+
 #: mesh.polar_radius = "auto": the polar ring's outer radius over the nearest boundary's
 #: distance (6.8 a in the default 8 a wide half domain, the radius measured on every level).
 POLAR_RING_SHARE = 0.85
@@ -319,6 +342,42 @@ Refinement = Annotated[Union[tuple(Annotated[m, Tag(t)] for t, m in REFINE_KINDS
                        Discriminator(_refine_kind)]
 
 
+class SideBox(BaseModel):
+    """Where the followed meniscus is the region's side (``mesh.follow.sides``), units of a:
+    the band's points with x_min <= x <= x_max and |y| >= y_min get a second band of half the
+    level's cells and half its half-width. The width is set there: the meniscus meeting both
+    walls spans 0.13-0.2 a in plane where the gap is 60-95 um (docs/cases.md, "Three steps
+    of one series")."""
+
+    model_config = _STRICT
+    x_min: float = Field(ge=-200.0, le=200.0)
+    x_max: float = Field(ge=-200.0, le=200.0)
+    y_min: float = Field(0.0, ge=0.0, le=200.0)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "SideBox":
+        if not self.x_min < self.x_max:
+            raise ValueError(f"x_min = {self.x_min:g} a must be below x_max = {self.x_max:g} a")
+        return self
+
+    def holds(self, points: np.ndarray) -> np.ndarray:
+        """Which of the (k, 2) points (x, |y|), units of a, lie in the box (bool, k)."""
+        x, y = points[:, 0], np.abs(points[:, 1])
+        return (x >= self.x_min) & (x <= self.x_max) & (y >= self.y_min)
+
+
+class Follow(BaseModel):
+    """A mesh that follows the meniscus of the state the case starts from (``mesh.follow``,
+    with ``ehlfoam case --start-from``): bands of the level's cells
+    (:data:`FOLLOW_LEVELS`) within ``half_width`` (a) of the start state's mid-gap meniscus,
+    and optionally a finer band on the region's sides (:class:`SideBox`). The written case
+    has the bands in ``mesh.refine`` and the level's sizes spelled out."""
+
+    model_config = _STRICT
+    half_width: float = Field(1.0, gt=0.0, le=20.0)
+    sides: SideBox | None = None
+
+
 class Mesh(BaseModel):
     """Resolution level (see :data:`RESOLUTIONS`) and optional overrides.
 
@@ -343,6 +402,7 @@ class Mesh(BaseModel):
             0.95 x the nearest boundary. A circular meniscus meets every ring cell the same
             way, which converges the flooded width where free quads do not (docs/cases.md,
             "A polar ring around the contact", "The polar ring becomes the default").
+            With ``follow``, "auto" is :data:`FOLLOW_POLAR_RADIUS`.
         columns: how the columns of nodes cross the gap: "normal" (the default) leans each
             column so that it meets every layer at right angles (an in-plane shift of a
             few um at most), "vertical" keeps them upright, which makes every face where
@@ -354,6 +414,10 @@ class Mesh(BaseModel):
             width"), and an advancing meniscus on dry walls holds its suction only in cells
             within some 15 wall cells ("The region's sides are moving contact lines").
             ``ehlfoam band CASE`` writes bands along a run's meniscus. Empty by default.
+        follow: the following levels (:class:`Follow`, :data:`FOLLOW_LEVELS`): the mesh
+            follows the meniscus of the state the case starts from (``--start-from``); the
+            level then sets the band's cells and the wall cell, on :data:`FOLLOW_BASE`.
+            None (the default): the levels of :data:`RESOLUTIONS`.
     """
 
     model_config = _STRICT
@@ -366,6 +430,7 @@ class Mesh(BaseModel):
     polar_radius: float | Literal["auto"] | None = "auto"
     columns: Literal["normal", "vertical"] = "normal"
     refine: tuple[Refinement, ...] = ()
+    follow: Follow | None = None
 
     @field_validator("polar_radius", mode="before")
     @classmethod
@@ -392,15 +457,27 @@ class Mesh(BaseModel):
         ``size_far`` (a), ``wall_grading`` (-) and ``wall_cell`` [m]. One of the last two
         is None: with ``wall_cell`` set the columns are graded for it and the level's
         grading does not apply."""
-        out = dict(RESOLUTIONS[self.resolution])
+        if self.follow is None:
+            out = dict(RESOLUTIONS[self.resolution])
+            wall_cell = self.wall_cell
+        else:
+            out = {**FOLLOW_BASE, "wall_grading": None}
+            wall_cell = (self.wall_cell if self.wall_cell is not None or self.wall_grading
+                         is not None else FOLLOW_LEVELS[self.resolution]["wall_cell"])
         for key in ("n_layers", "size_rim", "size_far", "wall_grading"):
             if getattr(self, key) is not None:
                 out[key] = getattr(self, key)
         out["n_layers"] = int(out["n_layers"])
-        out["wall_cell"] = self.wall_cell
-        if self.wall_cell is not None:
+        out["wall_cell"] = wall_cell
+        if wall_cell is not None:
             out["wall_grading"] = None
         return out
+
+    @property
+    def follow_band(self) -> float | None:
+        """In-plane cell size (a) of the band along the followed meniscus (None without
+        ``follow``)."""
+        return None if self.follow is None else FOLLOW_LEVELS[self.resolution]["band"]
 
 
 class Run(BaseModel):
@@ -517,6 +594,8 @@ class CaseSpec(BaseModel):
         """Outer radius of the polar ring, units of a (``mesh.polar_radius`` with "auto"
         resolved against the domain), or None for free quads."""
         rp, d = self.mesh.polar_radius, self.domain
+        if rp == "auto" and self.mesh.follow is not None:
+            return FOLLOW_POLAR_RADIUS
         if rp == "auto":
             return POLAR_RING_SHARE * min(d.upstream, d.downstream, d.side)
         return rp

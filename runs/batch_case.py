@@ -96,7 +96,8 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
     from generator.gap_source import precalc_dir
     from runs.run_case import CaseBusy, run_case
 
-    from .ramp import seed_case, seed_from_previous
+    from .follow_meniscus import following_spec
+    from .ramp import seed_case
 
     pc = plan_index(batch_dir)[case_id]
     case = batch_dir / CASES / case_id
@@ -116,17 +117,20 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
         try:
             with _precalc_lock(pc.spec.contact):
                 precalc_dir(pc.spec.contact, require_converged=False)
-            write_case(pc.spec, case, overwrite=True)
+            source = None
             if pc.ramp and pc.ramp.get("previous"):
                 stage = "ramp start"
-                previous = batch_dir / CASES / pc.ramp["previous"]
-                if case_status(previous) != "finished":
-                    raise RuntimeError(f"the previous ramp step {previous.name} is not "
-                                       f"finished ({case_status(previous)})")
-                seed = seed_from_previous(case, previous)
+                source = batch_dir / CASES / pc.ramp["previous"]
+                if case_status(source) != "finished":
+                    raise RuntimeError(f"the previous ramp step {source.name} is not "
+                                       f"finished ({case_status(source)})")
             elif pc.ramp and pc.ramp.get("start_from"):   # the first step: a case or state
+                source = pc.ramp["start_from"]
+            stage = "build"   # with mesh.follow, along the source's meniscus
+            write_case(following_spec(pc.spec, source), case, overwrite=True)
+            if source is not None:
                 stage = "ramp start"
-                seed = seed_case(case, pc.ramp["start_from"])
+                seed = seed_case(case, source)
             build_s = time.monotonic() - t0
             stage = "run"
             metrics = run_case(case)

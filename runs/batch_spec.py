@@ -504,6 +504,12 @@ def expand(batch: BatchSpec) -> list[PlannedCase]:
             if step == 1 and r.start_from:
                 ramp["start_from"] = str(Path(r.start_from).absolute())
             previous = _add(plan, batch, p, s, ramp)
+    for pc in plan.values():
+        if pc.spec.mesh.follow is not None and not (
+                pc.ramp and (pc.ramp.get("previous") or pc.ramp.get("start_from"))):
+            raise SpecError(f"invalid batch spec: case {pc.id} has mesh.follow but no state to "
+                            f"start from, whose meniscus its mesh would follow: only a ramp's "
+                            f"steps have one (its start_from, or the step before)")
     return list(plan.values())
 
 

@@ -52,7 +52,7 @@ def cmd_case(args: argparse.Namespace) -> int:
     """Validate the spec, then build the case (precalc, mesh, OpenFOAM files)."""
     from ehl_precalc.spec import SpecError
     from generator.case_spec import load_case_spec, make_case_spec
-    from generator.case_writer import CaseExists, mesh_warnings, write_case
+    from generator.case_writer import CaseExists, mesh_warnings
 
     overrides = dict(kv.split("=", 1) for kv in args.set or [])
     try:
@@ -62,6 +62,10 @@ def cmd_case(args: argparse.Namespace) -> int:
     except (SpecError, ValueError) as err:
         print(f"ehlfoam case: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if spec.mesh.follow is not None and not args.start_from:
+        print("ehlfoam case: mesh.follow needs --start-from (a run case, a case snapshot or a "
+              "thin-film state): the mesh follows that state's meniscus", file=sys.stderr)
+        return EXIT_BAD_INPUT
     if args.start_from:
         from runs.ramp import RampError, check_start
 
@@ -70,20 +74,26 @@ def cmd_case(args: argparse.Namespace) -> int:
         except (RampError, OSError) as err:   # missing, or not a folder
             print(f"ehlfoam case: --start-from {args.start_from}: {err}", file=sys.stderr)
             return EXIT_BAD_INPUT
+    from runs.follow_meniscus import write_started_case
+    from runs.ramp import RampError
+
     try:
-        geom = write_case(spec, args.out, overwrite=args.overwrite)
+        geom, seed = write_started_case(spec, args.out, args.start_from,
+                                        overwrite=args.overwrite)
     except CaseExists as err:
         print(f"ehlfoam case: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    if args.start_from:
-        from runs.ramp import RampError, seed_case
-
-        try:
-            seed = seed_case(args.out, args.start_from)
-        except RampError as err:   # found only on the new mesh: leave no half-made case
-            shutil.rmtree(args.out, ignore_errors=True)
-            print(f"ehlfoam case: --start-from {args.start_from}: {err}", file=sys.stderr)
-            return EXIT_BAD_INPUT
+    except RampError as err:   # found only on the new mesh: leave no half-made case
+        shutil.rmtree(args.out, ignore_errors=True)
+        print(f"ehlfoam case: --start-from {args.start_from}: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except ValueError as err:   # mesh.follow: the source has no meniscus to follow
+        if spec.mesh.follow is None:
+            raise
+        shutil.rmtree(args.out, ignore_errors=True)
+        print(f"ehlfoam case: --start-from {args.start_from}: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    if seed is not None:
         at = ("" if seed["previous_time_s"] is None
               else f" at t = {seed['previous_time_s']:.4g} s")
         print(f"starts from {args.start_from}{at} ({seed['method']}: "

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from generator.case_spec import RefineBand
+from generator.case_spec import RefineBand, SideBox
 from generator.case_writer import load_geometry
 
 from . import case_fields, metrics
@@ -91,6 +91,22 @@ def meniscus_bands(lines: list[np.ndarray], size: float, half_width: float,
         bands.append(RefineBand(points=tuple(map(tuple, pts.tolist())),
                                 half_width=half_width, size=size))
     return bands
+
+
+def side_bands(bands: list[RefineBand], sides: SideBox) -> list[RefineBand]:
+    """A band of half the size and half the half-width along each run of consecutive points
+    of ``bands`` that lies in ``sides`` (the region's sides, where the meniscus sets the
+    width; :class:`~generator.case_spec.SideBox`). Runs of a single point are left out."""
+    out = []
+    for band in bands:
+        pts = np.asarray(band.points, float)
+        held = sides.holds(pts).astype(int)
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], held, [0]])))
+        for i, j in zip(edges[::2], edges[1::2]):
+            if j - i >= 2:
+                out.append(RefineBand(points=tuple(map(tuple, pts[i:j].tolist())),
+                                      half_width=0.5 * band.half_width, size=0.5 * band.size))
+    return out
 
 
 def bands_toml(bands: list[RefineBand]) -> str:

@@ -218,6 +218,27 @@ def test_ramp_starts_from_a_run_case(tiny, tmp_path, capsys):
         json.loads((source / "metrics.json").read_text())["oil_volume_m3"], rel=1e-3, abs=0)
 
 
+def test_ramp_steps_with_mesh_follow_follow_the_meniscus_they_start_from(tiny, tmp_path):
+    """With ``mesh.follow`` every ramp step's mesh has bands along the meniscus of what it
+    starts from (start_from, then the step before), and its written spec keeps them."""
+    source = tiny[1].batch_dir / CASES / RAMP[1]
+    base = BASE.replace("wall_grading = 3.0 }",
+                        "wall_grading = 3.0, follow = { half_width = 0.5 } }")
+    assert base != BASE
+    ramp = "[[ramp]]\nname = \"F\"\nspeed_mm_s = [15, 25]\nbranches = \"up\"\n"
+    spec = _spec(tmp_path, "follow", base + ramp + f"start_from = \"{source}\"\n")
+    outcome = run_batch(spec, BatchOptions(jobs=1, quiet=True, report=False))
+    assert outcome.exit_code == 0
+    for step in ("rampF_up01_u15.0_s3um_T40_F20_coarse", "rampF_up02_u25.0_s3um_T40_F20_coarse"):
+        case = outcome.batch_dir / CASES / step
+        mesh = json.loads((case / "ehlfoam" / "spec.json").read_text())["mesh"]
+        assert mesh["follow"] is None and mesh["refine"]
+        assert {b["size"] for b in mesh["refine"]} == {0.24}
+        info = json.loads((case / "ehlfoam" / "ramp.json").read_text())
+        assert info["method"] == "interpolated"   # its own mesh, not the source's
+        assert json.loads((case / "metrics.json").read_text())["status"] == "finished"
+
+
 def test_rerun_keeps_finished_and_failed_cases(tiny):
     spec, outcome = tiny
     before = _mtimes(outcome.batch_dir)
