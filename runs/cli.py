@@ -215,7 +215,8 @@ def build_parser() -> argparse.ArgumentParser:
                            "neighbour: another speed, supply or level), copied on the same "
                            "mesh, else interpolated; from a case snapshot (`ehlfoam "
                            "snapshot`); or from the oil of a thin-film state "
-                           "(bench/thin_film_region.py writes them)")
+                           "(bench/thin_film_region.py writes them). With mesh.follow the "
+                           "mesh follows its meniscus (needed then)")
     case.set_defaults(func=cmd_case)
 
     run = sub.add_parser(
