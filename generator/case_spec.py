@@ -462,8 +462,9 @@ class Mesh(BaseModel):
             wall_cell = self.wall_cell
         else:
             out = {**FOLLOW_BASE, "wall_grading": None}
-            wall_cell = (self.wall_cell if self.wall_cell is not None or self.wall_grading
-                         is not None else FOLLOW_LEVELS[self.resolution]["wall_cell"])
+            wall_cell = self.wall_cell
+            if wall_cell is None and self.wall_grading is None:   # the level's wall cell
+                wall_cell = FOLLOW_LEVELS[self.resolution]["wall_cell"]
         for key in ("n_layers", "size_rim", "size_far", "wall_grading"):
             if getattr(self, key) is not None:
                 out[key] = getattr(self, key)

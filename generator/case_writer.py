@@ -497,7 +497,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
     if spec.mesh.follow is not None:
         raise ValueError("mesh.follow needs the state the case starts from, whose meniscus "
                          "the mesh follows: ehlfoam case SPEC --out DIR --start-from SOURCE "
-                         "(runs.follow_meniscus.write_following_case)")
+                         "(runs.follow_meniscus.write_started_case)")
     if out.exists() and any(out.iterdir()):
         if not overwrite:
             raise CaseExists(f"output folder {out} exists and is not empty (use --overwrite)")
