@@ -3,9 +3,9 @@
 The levels of :data:`~generator.case_spec.RESOLUTIONS` leave the meniscus in their base cells,
 and the flooded width does not converge over them; with bands of cells along the whole
 meniscus, twice as fine on the region's sides, and one thin wall cell everywhere
-(:data:`~generator.case_spec.FOLLOW_LEVELS`), the inlet meniscus and the width lie within
-2.6 % and 0.7 % of the fine level's from the medium level on (docs/cases.md, "Resolved
-levels"). A case of such a level is written in three steps:
+(:data:`~generator.case_spec.FOLLOW_LEVELS`, whose comment gives what they converge), the
+meniscus is resolved on every level (docs/cases.md, "Resolved levels"). A case of such a
+level is written in three steps:
 
 1. a probe case on the level's base mesh, without bands, started from the source
    (``--start-from``: a run case, a case snapshot or a thin-film state);
