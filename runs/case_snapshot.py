@@ -35,7 +35,7 @@ from ehl_precalc.outputs import atomic_write
 from generator.case_writer import META, load_geometry
 
 from .case_fields import Structure, time_folders, write_near
-from .field_mapping import LayeredMesh, interpolate
+from .field_mapping import LayeredMesh, carry_oil, interpolate
 from .ramp import check_same_gap, write_seed
 
 #: The ``kind`` entry that tells a snapshot from a thin-film state (both are .npz).
@@ -71,7 +71,9 @@ def save_snapshot(case: str | Path, path: str | Path, at: str = "last",
                   fields: tuple[str, ...] = FIELDS) -> dict[str, Any]:
     """Write the fields of ``case``'s write nearest ``at`` transits ("last": its last write)
     to ``path`` (a compressed .npz, written atomically). Returns the snapshot's record:
-    {"source", "time_s", "transits", "cells", "fields", "spec", "history"}."""
+    {"source", "time_s", "transits", "cells", "columns", "layers", "mesh_oil_m3",
+    "mesh_volume_m3" (the oil and the volume in its mesh, a half domain's half), "fields",
+    "spec", "history"}."""
     case, path = Path(case), Path(path)
     if path.suffix != ".npz":
         raise SnapshotError(f"snapshot file = {str(path)!r} must end in .npz")
@@ -98,6 +100,8 @@ def save_snapshot(case: str | Path, path: str | Path, at: str = "last",
     history = case / "history.csv"
     record = {"source": str(case), "time_s": t, "transits": t / geom.transit_time,
               "cells": len(s.base_cell), "columns": n_base, "layers": n_layers,
+              "mesh_oil_m3": float(s.cell_volumes @ np.clip(values["alpha.oil"], 0.0, 1.0)),
+              "mesh_volume_m3": float(s.cell_volumes.sum()),
               "fields": list(fields),
               "spec": json.loads(spec.read_text()) if spec.is_file() else None,
               "history": history.read_text() if history.is_file() else None}
@@ -156,40 +160,70 @@ def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]
     """Write a snapshot's fields as ``case``'s initial fields (its ``0.orig/``), interpolated
     layer by layer onto its mesh (:mod:`.field_mapping`; the same mesh gets its own values
     back, to the snapshot's precision). Returns (and writes to ``case/ehlfoam/ramp.json``)
-    {"previous", "previous_time_s", "method": "snapshot", "fields", "cells", "source"}."""
+    {"previous", "previous_time_s", "method": "snapshot", "fields", "cells", "source", "oil"
+    (how the oil was carried over, :func:`.field_mapping.carry_oil`)}."""
     case, snapshot = Path(case).absolute(), Path(snapshot).absolute()
     source, their_gap, fields, record = load_snapshot(snapshot)
     target = LayeredMesh.load(case)
     s = Structure.load(case)
     gap_at = interpolate(their_gap[source.base_cell], source, target)
     check_same_gap(s.gap_mean(gap_at), s, snapshot)
-    out = {}
+    out, oil = {}, None
     for name, value in fields.items():
         if not (case / "0.orig" / name).is_file():
             continue
-        mapped = interpolate(value, source, target)
-        out[name] = np.clip(mapped, 0.0, 1.0) if name == "alpha.oil" else mapped
+        out[name] = interpolate(value, source, target)
+        if name == "alpha.oil":
+            out[name], oil = carry_oil(out[name], s.cell_volumes, *_source_oil(record, case, s))
     return write_seed(case, out, {
         "previous": os.path.relpath(snapshot, case), "previous_time_s": record["time_s"],
-        "method": "snapshot", "fields": sorted(out), "source": record["source"]})
+        "method": "snapshot", "fields": sorted(out), "source": record["source"], "oil": oil})
+
+
+def _source_oil(record: dict[str, Any], case: Path, s: Structure
+                ) -> tuple[float | None, float | None]:
+    """(oil, domain volume) [m^3] in the mesh of a snapshot's source. Snapshots written
+    before 2026-11-29 keep neither: their run's history gives the oil at the snapshot's time
+    (halved in a half domain), and the case's own volume stands for the domain's when the
+    source's spec names the case's domain."""
+    if "mesh_oil_m3" in record:
+        return record["mesh_oil_m3"], record["mesh_volume_m3"]
+    domain = (record.get("spec") or {}).get("domain")
+    try:
+        history, _ = snapshot_history_of(record)
+    except SnapshotError:
+        return None, None
+    if domain is None:
+        return None, None
+    oil = float(history["oil_volume_m3"][-1]) / (2.0 if domain["symmetry"] == "half" else 1.0)
+    own = json.loads((case / META / "spec.json").read_text()).get("domain")
+    return oil, float(s.cell_volumes.sum()) if domain == own else None
 
 
 def snapshot_history(snapshot: str | Path) -> tuple[dict[str, np.ndarray], float]:
     """(history columns, transit time [s]) of the run a snapshot was taken from, its
     history.csv up to the snapshot's write as :func:`runs.report.case_data.read_history`
     reads it; raises :class:`SnapshotError` when it kept none."""
+    _require_snapshot(snapshot)
+    with np.load(snapshot, allow_pickle=False) as d:   # the record only, not the fields
+        record = json.loads(str(d["record"]))
+    try:
+        return snapshot_history_of(record)
+    except SnapshotError as err:
+        raise SnapshotError(f"{snapshot}: {err}") from None
+
+
+def snapshot_history_of(record: dict[str, Any]) -> tuple[dict[str, np.ndarray], float]:
+    """:func:`snapshot_history` of a snapshot's record."""
     import csv
     import io
 
     from .report.case_data import history_columns
 
-    _require_snapshot(snapshot)
-    with np.load(snapshot, allow_pickle=False) as d:   # the record only, not the fields
-        record = json.loads(str(d["record"]))
     columns = (history_columns(list(csv.DictReader(io.StringIO(record["history"]))))
-               if record["history"] else None)
+               if record.get("history") else None)
     if columns is None or record["transits"] <= 0.0:
-        raise SnapshotError(f"{snapshot}: its run kept no history.csv")
+        raise SnapshotError("its run kept no history.csv")
     keep = columns["time_s"] <= record["time_s"] * (1.0 + 1e-9)
     return {k: v[keep] for k, v in columns.items()}, record["time_s"] / record["transits"]
 

@@ -22,6 +22,7 @@ from collections.abc import Sequence
 
 from ehl_precalc import cli as precalc_cli
 from runs import batch_cli, case_snapshot, meniscus_band
+from runs.field_mapping import oil_carried
 from runs.report import add_parser as _report_add_parser
 from runs.foam_runtime import (
     FoamConfigError,
@@ -98,6 +99,8 @@ def cmd_case(args: argparse.Namespace) -> int:
               else f" at t = {seed['previous_time_s']:.4g} s")
         print(f"starts from {args.start_from}{at} ({seed['method']}: "
               f"{', '.join(seed['fields'])})")
+        if seed.get("oil"):
+            print(oil_carried(seed["oil"]))
     print(f"case {args.out}: {geom.solver}, {geom.cells} cells, a = {geom.a * 1e3:.4f} mm, "
           f"transit {geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, "
           f"maxDeltaT {geom.max_delta_t:.3g} s ({geom.capillary_limit}), "

@@ -15,8 +15,13 @@ the ball). A value is carried over in two steps:
 OpenFOAM's ``mapFields -consistent`` did this job before; on these meshes it crashes
 (segmentation fault while interpolating, coarse to fine level of a cavitating case), and a
 meshSearch in 3D has no notion of the layers, so it mixes cells of different heights across a
-gap that is hundreds of times thinner than wide. The result is interpolated, not conservative:
-the oil volume carried over changes by a few per cent where an interface crosses coarse cells.
+gap that is hundreds of times thinner than wide.
+
+Interpolation alone does not conserve the oil: where an interface crosses coarse cells the
+oil carried over changes, by 0.02, 0.18 and 0.68 nl of 185 nl from the study's rests to the
+coarse, medium and fine following levels (2026-11-29), and a region then spends transits
+shedding or drawing what the mapping added. :func:`carry_oil` puts the source's oil volume
+back, by moving the interface within its cells only (:func:`conserve_oil`).
 """
 
 from __future__ import annotations
@@ -101,3 +106,62 @@ def interpolate(values: np.ndarray, source: LayeredMesh, target: LayeredMesh) ->
         w = np.clip((zt - z0) / np.maximum(z1 - z0, 1e-300), 0.0, 1.0)[:, None]
         out = (1.0 - w) * v[b, i] + w * v[b, i + 1]
     return out.reshape((len(out),) + values.shape[1:])
+
+
+#: How much two meshes' total volumes may differ and still be one domain, for
+#: :func:`carry_oil`: the three following levels of the nominal case differ by 0.015 %
+#: (2026-11-29); other extents differ by far more, and on another domain the source's oil
+#: volume is not the target's.
+SAME_DOMAIN = 0.01
+
+
+def conserve_oil(alpha: np.ndarray, volumes: np.ndarray, oil_m3: float
+                 ) -> tuple[np.ndarray, float]:
+    """Oil fractions ``alpha`` (C,) shifted within the interface cells so that they hold
+    ``oil_m3`` [m^3] in cells of ``volumes`` [m^3]: alpha + c alpha (1 - alpha), which leaves
+    the full and empty cells as they are, stays in [0, 1] for |c| <= 1 and moves the
+    interface by about c / 4 of a cell. Returns (fractions, c); c is clipped to [-1, 1], so
+    a gap wider than the interface cells can take is only narrowed."""
+    alpha = np.clip(np.asarray(alpha, dtype=float), 0.0, 1.0)
+    room = volumes @ (alpha * (1.0 - alpha))
+    if room <= 0.0:
+        return alpha, 0.0
+    c = float(np.clip((oil_m3 - volumes @ alpha) / room, -1.0, 1.0))
+    return alpha + c * alpha * (1.0 - alpha), c
+
+
+def carry_oil(alpha: np.ndarray, volumes: np.ndarray, source_oil_m3: float | None,
+              source_volume_m3: float | None) -> tuple[np.ndarray, dict]:
+    """Interpolated oil fractions ``alpha`` on cells of ``volumes`` [m^3] given the oil of
+    their source (``source_oil_m3`` in a domain of ``source_volume_m3``), by
+    :func:`conserve_oil` when both are known and the domains' volumes agree within
+    :data:`SAME_DOMAIN`. Returns (fractions, record): {"source_m3", "interpolated_m3",
+    "carried_m3", "shift", "conserved", "reason"}."""
+    alpha = np.clip(np.asarray(alpha, dtype=float), 0.0, 1.0)
+    interpolated = float(volumes @ alpha)
+    record = {"source_m3": source_oil_m3, "interpolated_m3": interpolated,
+              "carried_m3": interpolated, "shift": 0.0, "conserved": False}
+    if source_oil_m3 is None or source_volume_m3 is None:
+        return alpha, {**record, "reason": "the source records no oil volume"}
+    mismatch = abs(float(volumes.sum()) / source_volume_m3 - 1.0)
+    if mismatch > SAME_DOMAIN:
+        return alpha, {**record, "reason": f"the domains' volumes differ by {mismatch:.1%} "
+                                           f"(one domain: within {SAME_DOMAIN:.0%})"}
+    out, c = conserve_oil(alpha, volumes, source_oil_m3)
+    carried = float(volumes @ out)
+    conserved = abs(carried - source_oil_m3) <= 1e-9 * source_oil_m3
+    return out, {**record, "carried_m3": carried, "shift": c, "conserved": conserved,
+                 "reason": "" if conserved else "the interface cells cannot take the "
+                                                "difference (shift clipped at 1)"}
+
+
+def oil_carried(record: dict) -> str:
+    """One line on how :func:`carry_oil` carried the oil over."""
+    if record["source_m3"] is None:
+        return f"oil: as interpolated ({record['reason']})"
+    off = record["interpolated_m3"] / record["source_m3"] - 1.0
+    if record["conserved"]:
+        return (f"oil: the source's volume kept (interpolated it was {off:+.3%}; the "
+                f"interface moved within its cells, c = {record['shift']:+.3g})")
+    return (f"oil: {record['carried_m3'] / record['source_m3'] - 1.0:+.3%} of the source's "
+            f"volume, not kept: {record['reason']}")

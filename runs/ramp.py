@@ -9,7 +9,7 @@ the in-plane cells, depend on the load only, and the gap heights differ by nanom
 final internal fields are copied cell by cell (exact, the equivalent of mapFields on an
 identical mesh). If the meshes differ (other cell count or in-plane positions), they are
 interpolated layer by layer across the gap (:mod:`.field_mapping`; OpenFOAM's mapFields crashes
-on these meshes). Either way only the internal fields are
+on these meshes), the oil put back to the previous case's volume. Either way only the internal fields are
 taken over: the boundary conditions stay those of the new case (walls at the new speed).
 
 The seeded fields are written into the new case's ``0.orig/`` (its initial condition, copied
@@ -31,7 +31,7 @@ from ehl_precalc.outputs import atomic_write_json
 from generator.case_writer import META, load_geometry
 
 from .case_fields import Structure, time_folders
-from .field_mapping import LayeredMesh, interpolate
+from .field_mapping import LayeredMesh, carry_oil, interpolate
 
 #: The fields a ramp step takes over (internal values only) when its 0.orig/ has them:
 #: alpha.oil, U, p_rgh (interFoam), also p and T (compressibleInterFoam).
@@ -91,17 +91,24 @@ def _copied_fields(folder: Path, names: list[str]) -> dict[str, Any]:
     return {name: _read_internal(folder / name) for name in names}
 
 
-def _mapped_fields(case: Path, previous: Path, folder: Path, names: list[str]) -> dict[str, Any]:
-    """Internal fields interpolated onto the new mesh layer by layer (:mod:`.field_mapping`);
-    a uniform field is taken over as it is."""
+def _mapped_fields(case: Path, previous: Path, folder: Path, names: list[str]
+                   ) -> tuple[dict[str, Any], dict[str, Any] | None]:
+    """Internal fields interpolated onto the new mesh layer by layer (:mod:`.field_mapping`),
+    the oil at the previous case's volume (:func:`.field_mapping.carry_oil`, whose record
+    comes second); a uniform field is taken over as it is."""
     source, target = LayeredMesh.load(previous), LayeredMesh.load(case)
-    out = {}
+    out: dict[str, Any] = {}
+    oil = None
     for name in names:
         value = _read_internal(folder / name)
         arr = np.asarray(value, dtype=float)
         uniform = arr.ndim == 0 or (arr.ndim == 1 and len(arr) != len(source.base_cell))
         out[name] = value if uniform else interpolate(arr, source, target)
-    return out
+        if name == "alpha.oil" and not uniform:
+            theirs, own = (Structure.load(c).cell_volumes for c in (previous, case))
+            out[name], oil = carry_oil(out[name], own, float(theirs @ np.clip(arr, 0.0, 1.0)),
+                                       float(theirs.sum()))
+    return out, oil
 
 
 def _write_internal(path: Path, value: Any) -> None:
@@ -119,17 +126,19 @@ def seed_from_previous(case: str | Path, previous: str | Path) -> dict[str, Any]
     same mesh, else interpolated layer by layer (:mod:`.field_mapping`).
 
     Returns (and writes to ``case/ehlfoam/ramp.json``) {"previous" (relative to the case),
-    "previous_time_s", "method", "fields", "cells"}.
+    "previous_time_s", "method", "fields", "oil" (how the oil was carried over, see
+    :func:`.field_mapping.carry_oil`; None for a copy), "cells"}.
     """
     case, previous = Path(case).absolute(), Path(previous).absolute()
     t, folder = final_time(previous)
     names = fields_to_carry(case, folder)
     if same_mesh(case, previous):
-        fields, method = _copied_fields(folder, names), "copy"
+        fields, method, oil = _copied_fields(folder, names), "copy", None
     else:
-        fields, method = _mapped_fields(case, previous, folder, names), "interpolated"
+        (fields, oil), method = _mapped_fields(case, previous, folder, names), "interpolated"
     return write_seed(case, fields, {"previous": os.path.relpath(previous, case),
-                                     "previous_time_s": t, "method": method, "fields": names})
+                                     "previous_time_s": t, "method": method, "fields": names,
+                                     "oil": oil})
 
 
 def write_seed(case: Path, fields: dict[str, Any], info: dict[str, Any]) -> dict[str, Any]:

@@ -8,7 +8,8 @@ from scipy.spatial import Delaunay
 
 from generator.case_spec import make_case_spec
 from generator.case_writer import load_geometry, write_case
-from runs.field_mapping import LayeredMesh, interpolate
+from runs.case_fields import Structure
+from runs.field_mapping import LayeredMesh, carry_oil, conserve_oil, interpolate, oil_carried
 from tiny import SMALL
 
 
@@ -82,3 +83,45 @@ def test_values_stay_within_the_source_range(meshes):
     alpha = (rng.random(len(src.zeta)) > 0.5).astype(float)
     got = interpolate(alpha, src, dst)
     assert got.min() >= 0.0 and got.max() <= 1.0
+
+
+def test_conserve_oil_moves_only_the_interface_cells_to_the_volume_asked():
+    rng = np.random.default_rng(3)
+    volumes = rng.uniform(1.0, 2.0, 400)
+    alpha = np.r_[np.zeros(150), np.ones(150), rng.uniform(0.0, 1.0, 100)]
+    for target in (volumes @ alpha * 1.01, volumes @ alpha * 0.99):
+        out, c = conserve_oil(alpha, volumes, target)
+        assert volumes @ out == pytest.approx(target, rel=1e-12)
+        assert abs(c) <= 1.0 and out.min() >= 0.0 and out.max() <= 1.0
+        np.testing.assert_array_equal(out[:300], alpha[:300])   # full and empty cells kept
+        assert np.all(np.sign(out[300:] - alpha[300:]) == np.sign(target - volumes @ alpha))
+    # more than the interface cells can take: shifted as far as they go, and no further
+    out, c = conserve_oil(alpha, volumes, volumes @ alpha * 1.5)
+    assert c == 1.0 and out.max() <= 1.0 and volumes @ out < volumes @ alpha * 1.5
+    # no interface: nothing to move
+    sharp = np.r_[np.zeros(5), np.ones(5)]
+    out, c = conserve_oil(sharp, np.ones(10), 6.0)
+    assert c == 0.0 and np.array_equal(out, sharp)
+
+
+def test_carry_oil_keeps_the_sources_oil_across_meshes_of_one_domain(meshes):
+    """A sharp oil patch interpolated onto a finer mesh of the same domain gains or loses
+    oil where the interface crosses cells; carried over, it holds the source's volume."""
+    src, dst = (LayeredMesh.load(c) for c in meshes[:2])
+    v_src, v_dst = (Structure.load(c).cell_volumes for c in meshes[:2])
+    a = load_geometry(meshes[0]).a
+    xy = src.base_xy[src.base_cell] / a
+    alpha = ((xy[:, 0] + 1.0) ** 2 + xy[:, 1] ** 2 < 9.0).astype(float)
+    source_oil = float(v_src @ alpha)
+    mapped = interpolate(alpha, src, dst)
+    assert abs(v_dst @ mapped / source_oil - 1.0) > 1e-4          # interpolation drifts
+    out, record = carry_oil(mapped, v_dst, source_oil, float(v_src.sum()))
+    assert record["conserved"] and record["reason"] == ""
+    assert v_dst @ out == pytest.approx(source_oil, rel=1e-9)
+    assert out.min() >= 0.0 and out.max() <= 1.0
+    assert np.abs(out - mapped).max() < 0.25                        # within the cells
+    # another domain (its volume 5 % off): interpolated only, and the record says why
+    other, record = carry_oil(mapped, v_dst, source_oil, 1.05 * float(v_src.sum()))
+    assert not record["conserved"] and "domains' volumes differ by" in record["reason"]
+    np.testing.assert_array_equal(other, mapped)
+    assert "not kept" in oil_carried(record)
