@@ -164,8 +164,8 @@ def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]
     (how the oil was carried over, :func:`.field_mapping.carry_oil`)}."""
     case, snapshot = Path(case).absolute(), Path(snapshot).absolute()
     source, their_gap, fields, record = load_snapshot(snapshot)
-    target = LayeredMesh.load(case)
     s = Structure.load(case)
+    target = LayeredMesh.of(s)
     gap_at = interpolate(their_gap[source.base_cell], source, target)
     check_same_gap(s.gap_mean(gap_at), s, snapshot)
     out, oil = {}, None
@@ -182,22 +182,22 @@ def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]
 
 def _source_oil(record: dict[str, Any], case: Path, s: Structure
                 ) -> tuple[float | None, float | None]:
-    """(oil, domain volume) [m^3] in the mesh of a snapshot's source. Snapshots written
-    before 2026-11-29 keep neither: their run's history gives the oil at the snapshot's time
-    (halved in a half domain), and the case's own volume stands for the domain's when the
-    source's spec names the case's domain."""
+    """(oil, domain volume) [m^3] in the mesh of a snapshot's source, (None, None) when
+    unknown. Snapshots written before 2026-11-29 keep neither: when the source's spec names
+    the case's domain, its run's history gives the oil at the snapshot's time (over the
+    case's mirror, as the history counts the whole contact) and the case's own volume stands
+    for the domain's."""
     if "mesh_oil_m3" in record:
         return record["mesh_oil_m3"], record["mesh_volume_m3"]
-    domain = (record.get("spec") or {}).get("domain")
+    own = json.loads((case / META / "spec.json").read_text()).get("domain")
+    if (record.get("spec") or {}).get("domain") != own:
+        return None, None
     try:
         history, _ = snapshot_history_of(record)
     except SnapshotError:
         return None, None
-    if domain is None:
-        return None, None
-    oil = float(history["oil_volume_m3"][-1]) / (2.0 if domain["symmetry"] == "half" else 1.0)
-    own = json.loads((case / META / "spec.json").read_text()).get("domain")
-    return oil, float(s.cell_volumes.sum()) if domain == own else None
+    oil = float(history["oil_volume_m3"][-1]) / load_geometry(case).mirror
+    return oil, float(s.cell_volumes.sum())
 
 
 def snapshot_history(snapshot: str | Path) -> tuple[dict[str, np.ndarray], float]:

@@ -46,7 +46,11 @@ class LayeredMesh:
 
     @classmethod
     def load(cls, case: str | Path) -> "LayeredMesh":
-        s = Structure.load(case)
+        return cls.of(Structure.load(case))
+
+    @classmethod
+    def of(cls, s: Structure) -> "LayeredMesh":
+        """The layered mesh of a case's loaded :class:`~runs.case_fields.Structure`."""
         lo, hi = relative_heights(s)
         return cls(s.base_cell, s.layer, 0.5 * (lo + hi), np.stack([s.base_x, s.base_y], axis=1))
 
@@ -142,7 +146,8 @@ def carry_oil(alpha: np.ndarray, volumes: np.ndarray, source_oil_m3: float | Non
     record = {"source_m3": source_oil_m3, "interpolated_m3": interpolated,
               "carried_m3": interpolated, "shift": 0.0, "conserved": False}
     if source_oil_m3 is None or source_volume_m3 is None:
-        return alpha, {**record, "reason": "the source records no oil volume"}
+        return alpha, {**record, "reason": "the source records no oil volume, or another "
+                                           "domain"}
     mismatch = abs(float(volumes.sum()) / source_volume_m3 - 1.0)
     if mismatch > SAME_DOMAIN:
         return alpha, {**record, "reason": f"the domains' volumes differ by {mismatch:.1%} "

@@ -96,7 +96,8 @@ def _mapped_fields(case: Path, previous: Path, folder: Path, names: list[str]
     """Internal fields interpolated onto the new mesh layer by layer (:mod:`.field_mapping`),
     the oil at the previous case's volume (:func:`.field_mapping.carry_oil`, whose record
     comes second); a uniform field is taken over as it is."""
-    source, target = LayeredMesh.load(previous), LayeredMesh.load(case)
+    theirs, own = Structure.load(previous), Structure.load(case)
+    source, target = LayeredMesh.of(theirs), LayeredMesh.of(own)
     out: dict[str, Any] = {}
     oil = None
     for name in names:
@@ -105,9 +106,9 @@ def _mapped_fields(case: Path, previous: Path, folder: Path, names: list[str]
         uniform = arr.ndim == 0 or (arr.ndim == 1 and len(arr) != len(source.base_cell))
         out[name] = value if uniform else interpolate(arr, source, target)
         if name == "alpha.oil" and not uniform:
-            theirs, own = (Structure.load(c).cell_volumes for c in (previous, case))
-            out[name], oil = carry_oil(out[name], own, float(theirs @ np.clip(arr, 0.0, 1.0)),
-                                       float(theirs.sum()))
+            v = theirs.cell_volumes
+            out[name], oil = carry_oil(out[name], own.cell_volumes,
+                                       float(v @ np.clip(arr, 0.0, 1.0)), float(v.sum()))
     return out, oil
 
 
