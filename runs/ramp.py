@@ -9,8 +9,9 @@ the in-plane cells, depend on the load only, and the gap heights differ by nanom
 final internal fields are copied cell by cell (exact, the equivalent of mapFields on an
 identical mesh). If the meshes differ (other cell count or in-plane positions), they are
 interpolated layer by layer across the gap (:mod:`.field_mapping`; OpenFOAM's mapFields crashes
-on these meshes), the oil put back to the previous case's volume. Either way only the internal fields are
-taken over: the boundary conditions stay those of the new case (walls at the new speed).
+on these meshes), the oil put back to the previous case's volume. Either way only the internal
+fields are taken over: the boundary conditions stay those of the new case (walls at the new
+speed).
 
 The seeded fields are written into the new case's ``0.orig/`` (its initial condition, copied
 to ``0/`` by the run, and by the case's own Allrun), and ``ehlfoam/ramp.json`` records where
