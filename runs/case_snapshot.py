@@ -174,13 +174,13 @@ def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]
             continue
         out[name] = interpolate(value, source, target)
         if name == "alpha.oil":
-            out[name], oil = carry_oil(out[name], s.cell_volumes, *_source_oil(record, case, s))
+            out[name], oil = carry_oil(out[name], s.cell_volumes, *source_oil(record, case, s))
     return write_seed(case, out, {
         "previous": os.path.relpath(snapshot, case), "previous_time_s": record["time_s"],
         "method": "snapshot", "fields": sorted(out), "source": record["source"], "oil": oil})
 
 
-def _source_oil(record: dict[str, Any], case: Path, s: Structure
+def source_oil(record: dict[str, Any], case: Path, s: Structure
                 ) -> tuple[float | None, float | None]:
     """(oil, domain volume) [m^3] in the mesh of a snapshot's source, (None, None) when
     unknown. Snapshots written before 2026-11-29 keep neither: when the source's spec names

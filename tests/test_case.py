@@ -793,11 +793,19 @@ def test_cli_snapshot_keeps_a_runs_state_and_starts_another_case_from_it(tmp_pat
     assert s.cell_volumes @ start == pytest.approx(s.cell_volumes @ final, rel=1e-9)
     assert info["oil"]["conserved"]
     # a snapshot written before it kept its oil: the oil from its run's history
-    from runs.case_snapshot import _source_oil, load_snapshot
+    from runs.case_snapshot import source_oil, load_snapshot
     record = {k: v for k, v in load_snapshot(snap)[3].items() if not k.startswith("mesh_")}
-    oil, volume = _source_oil(record, second, s)
+    oil, volume = source_oil(record, second, s)
     assert oil == pytest.approx(s.cell_volumes @ final, rel=1e-6)
     assert volume == pytest.approx(s.cell_volumes.sum(), rel=1e-12)
+    # bench/cross_measure.py reads the kept state on a mesh as the run read its write
+    from bench.cross_measure import METRICS, measure_on
+    read = measure_on(snap, second)
+    assert read["cells"] == len(s.cell_volumes) and read["oil"]["conserved"]
+    measured = [k for k in METRICS if np.isfinite(series(first, k)[1]).any()]
+    assert measured                                            # a pattern to compare
+    for key in measured:
+        assert read[key] == pytest.approx(series(first, key)[1][-1], abs=1e-3), key
     u_final = np.asarray(FoamFieldFile(folder / "U").internal_field)
     u_start = np.asarray(FoamFieldFile(second / "0.orig" / "U").internal_field)
     assert np.abs(u_final).max() > 0.1 * SMALL["contact"]["speed"]
