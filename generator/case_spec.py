@@ -69,9 +69,9 @@ RESOLUTIONS: dict[str, dict[str, float]] = {
 #: cells and layers of :data:`FOLLOW_BASE`. They are the study series S13 / S12 / S11 of
 #: docs/cases.md with the bands centred on the start's meniscus: over them the inlet
 #: meniscus lies within 0.2 % of the fine level's from the medium level on, while the flooded
-#: width, 1.6 % apart there, still drifts on every level at the latest states measured
-#: ("Resolved levels", "The fine following level slows"); the levels of
-#: :data:`RESOLUTIONS` leave the meniscus in their base cells.
+#: width does not converge: the medium level rests 1.3-1.7 % wider than both others whatever
+#: it starts from, on the region's shoulders ("Resolved levels", "The medium level is
+#: wider"); the levels of :data:`RESOLUTIONS` leave the meniscus in their base cells.
 FOLLOW_LEVELS: dict[str, dict[str, float]] = {
     "coarse": {"band": 0.24, "wall_cell": 3.2e-6},
     "medium": {"band": 0.12, "wall_cell": 1.6e-6},
