@@ -5,11 +5,11 @@ different cell sizes?
     python bench/cross_measure.py SNAPSHOT.npz [...] --on CASE [...] [--save NAME.json]
 
 Each snapshot's oil fraction (``ehlfoam snapshot``) is interpolated onto the mesh of each
-case named by ``--on`` (the way a start on another mesh maps it, :mod:`runs.field_mapping`,
-its source's oil volume kept), and the flow pattern is read there from the mid-gap fraction
-as a run reads it (:mod:`runs.metrics`). Prints one table per metric, a row per snapshot
-(the state) and a column per mesh; the spread along a row is the reading's, the spread down
-a column the states'. Writes ``bench/results/NAME.json`` (default cross_measure.json).
+case named by ``--on`` the way a start on another mesh maps it (its source's oil volume
+kept; a snapshot of another contact is refused), and the flow pattern is read there from the
+mid-gap fraction as a run reads it (:mod:`runs.metrics`). Prints one table per metric, a row
+per snapshot (the state) and a column per mesh; the spread along a row is the reading's, the
+spread down a column the states'. Writes ``bench/results/NAME.json`` (default cross_measure.json).
 """
 from __future__ import annotations
 
@@ -26,21 +26,19 @@ from bench.common import log, save  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
 from runs import metrics  # noqa: E402
 from runs.case_fields import Structure, pattern_geometry  # noqa: E402
-from runs.case_snapshot import load_snapshot, source_oil  # noqa: E402
-from runs.field_mapping import LayeredMesh, carry_oil, interpolate  # noqa: E402
+from runs.case_snapshot import map_snapshot  # noqa: E402
 
 METRICS = ("flooded_width_over_a", "inlet_meniscus_distance_over_a", "flooded_length_over_a")
 
 
 def measure_on(snapshot: Path, case: Path) -> dict:
-    """The flow pattern of ``snapshot``'s state read on ``case``'s mesh, with how its oil
-    was carried over (:func:`runs.field_mapping.carry_oil`)."""
-    source, _, fields, record = load_snapshot(snapshot)
+    """The flow pattern of ``snapshot``'s state read on ``case``'s mesh, mapped as a start
+    from it would be (:func:`runs.case_snapshot.map_snapshot`: refused for another contact),
+    with how its oil was carried over (:func:`runs.field_mapping.carry_oil`)."""
     s = Structure.load(case)
     geom = load_geometry(case)
-    alpha = interpolate(fields["alpha.oil"], source, LayeredMesh.of(s))
-    alpha, oil = carry_oil(alpha, s.cell_volumes, *source_oil(record, case, s))
-    mid = s.mid_gap(alpha, geom.n_layers)
+    fields, oil, _ = map_snapshot(case, s, snapshot, ["alpha.oil"])
+    mid = s.mid_gap(fields["alpha.oil"], geom.n_layers)
     r = metrics.raster(s.base_x, s.base_y, mid, pattern_geometry(geom))
     pattern = metrics.flow_pattern_from_raster(r)
     return {"cells": len(s.cell_volumes), "oil": oil,
@@ -65,7 +63,8 @@ def main(argv: list[str] | None = None) -> int:
         log(" " * 44 + "".join(f"{c.name:>10}" for c in args.on))
         for snap in args.snapshots:
             row = [table[f"{snap}|{c}"][key] for c in args.on]
-            spread = np.ptp([v for v in row if v is not None]) if any(row) else float("nan")
+            known = [v for v in row if v is not None]
+            spread = np.ptp(known) if known else float("nan")
             log(f"{snap.stem[:44]:44}" + "".join(
                 f"{v:10.3f}" if v is not None else f"{'-':>10}" for v in row)
                 + f"   spread {spread:.3f}")

@@ -26,7 +26,7 @@ import json
 import os
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 import numpy as np
 from foamlib import FoamFieldFile
@@ -156,25 +156,37 @@ def load_snapshot(path: str | Path) -> tuple[LayeredMesh, np.ndarray, dict[str, 
         return mesh, d["gap"].astype(float), fields, json.loads(str(d["record"]))
 
 
-def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]:
-    """Write a snapshot's fields as ``case``'s initial fields (its ``0.orig/``), interpolated
-    layer by layer onto its mesh (:mod:`.field_mapping`; the same mesh gets its own values
-    back, to the snapshot's precision). Returns (and writes to ``case/ehlfoam/ramp.json``)
-    {"previous", "previous_time_s", "method": "snapshot", "fields", "cells", "source", "oil"
-    (how the oil was carried over, :func:`.field_mapping.carry_oil`)}."""
-    case, snapshot = Path(case).absolute(), Path(snapshot).absolute()
+def map_snapshot(case: Path, s: Structure, snapshot: Path, names: Iterable[str]
+                 ) -> tuple[dict[str, np.ndarray], dict[str, Any] | None, dict[str, Any]]:
+    """The snapshot's fields among ``names`` interpolated onto ``case``'s mesh (its loaded
+    :class:`Structure` ``s``), the oil at its source's volume: (fields, how the oil was
+    carried over (:func:`.field_mapping.carry_oil`; None without alpha.oil), the snapshot's
+    record). Raises :class:`.ramp.RampError` for a snapshot of another contact (its gaps
+    differ from the case's)."""
     source, their_gap, fields, record = load_snapshot(snapshot)
-    s = Structure.load(case)
     target = LayeredMesh.of(s)
     gap_at = interpolate(their_gap[source.base_cell], source, target)
     check_same_gap(s.gap_mean(gap_at), s, snapshot)
     out, oil = {}, None
+    wanted = set(names)
     for name, value in fields.items():
-        if not (case / "0.orig" / name).is_file():
+        if name not in wanted:
             continue
         out[name] = interpolate(value, source, target)
         if name == "alpha.oil":
             out[name], oil = carry_oil(out[name], s.cell_volumes, *source_oil(record, case, s))
+    return out, oil, record
+
+
+def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]:
+    """Write a snapshot's fields as ``case``'s initial fields (its ``0.orig/``), interpolated
+    layer by layer onto its mesh (:func:`map_snapshot`; the same mesh gets its own values
+    back, to the snapshot's precision). Returns (and writes to ``case/ehlfoam/ramp.json``)
+    {"previous", "previous_time_s", "method": "snapshot", "fields", "cells", "source", "oil"
+    (how the oil was carried over, :func:`.field_mapping.carry_oil`)}."""
+    case, snapshot = Path(case).absolute(), Path(snapshot).absolute()
+    own = [name for name in FIELDS if (case / "0.orig" / name).is_file()]
+    out, oil, record = map_snapshot(case, Structure.load(case), snapshot, own)
     return write_seed(case, out, {
         "previous": os.path.relpath(snapshot, case), "previous_time_s": record["time_s"],
         "method": "snapshot", "fields": sorted(out), "source": record["source"], "oil": oil})

@@ -802,7 +802,7 @@ def test_cli_snapshot_keeps_a_runs_state_and_starts_another_case_from_it(tmp_pat
     from bench.cross_measure import METRICS, measure_on
     read = measure_on(snap, second)
     assert read["cells"] == len(s.cell_volumes) and read["oil"]["conserved"]
-    measured = [k for k in METRICS if np.isfinite(series(first, k)[1]).any()]
+    measured = [k for k in METRICS if len(series(first, k)[1])]   # series skips NaN
     assert measured                                            # a pattern to compare
     for key in measured:
         assert read[key] == pytest.approx(series(first, key)[1][-1], abs=1e-3), key
