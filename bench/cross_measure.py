@@ -25,7 +25,7 @@ sys.path.insert(0, str(ROOT))
 from bench.common import log, save  # noqa: E402
 from generator.case_writer import load_geometry  # noqa: E402
 from runs import metrics  # noqa: E402
-from runs.case_fields import Structure, pattern_geometry  # noqa: E402
+from runs.case_fields import Structure, mid_gap_raster  # noqa: E402
 from runs.case_snapshot import map_snapshot  # noqa: E402
 
 METRICS = ("flooded_width_over_a", "inlet_meniscus_distance_over_a", "flooded_length_over_a")
@@ -38,9 +38,7 @@ def measure_on(snapshot: Path, case: Path) -> dict:
     s = Structure.load(case)
     geom = load_geometry(case)
     fields, oil, _ = map_snapshot(case, s, snapshot, ["alpha.oil"])
-    mid = s.mid_gap(fields["alpha.oil"], geom.n_layers)
-    r = metrics.raster(s.base_x, s.base_y, mid, pattern_geometry(geom))
-    pattern = metrics.flow_pattern_from_raster(r)
+    pattern = metrics.flow_pattern_from_raster(mid_gap_raster(fields["alpha.oil"], s, geom))
     return {"cells": len(s.cell_volumes), "oil": oil,
             **{k: pattern[k] for k in METRICS}}
 

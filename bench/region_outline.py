@@ -45,7 +45,7 @@ def outline(case: Path, at: float | None, stations_over_a: list[float],
     for _, folder in picked:
         oil = (st.gap_mean(case_fields.read_alpha(folder / "alpha.oil", st)) if gap_mean
                else case_fields.mid_gap_alpha(folder, st, g))
-        r = metrics.raster(st.base_x, st.base_y, oil, case_fields.pattern_geometry(g))
+        r = case_fields.column_raster(oil, st, g)
         widths = metrics.flooded_widths_at(r, np.asarray(stations_over_a) * g.a)
         rows.append([np.nan if w is None else w / g.a for w in widths])
         widest.append(metrics.flow_pattern_from_raster(r)["flooded_width_over_a"])

@@ -56,9 +56,7 @@ def measure(case: Path, name: str, structure: case_fields.Structure, geom,
     finally:
         if made:
             shutil.rmtree(folder)
-    r = metrics.raster(structure.base_x, structure.base_y, mid,
-                       case_fields.pattern_geometry(geom))
-    return metrics.flow_pattern_from_raster(r)
+    return metrics.flow_pattern_from_raster(case_fields.column_raster(mid, structure, geom))
 
 
 def window_means(rows: list[dict], span: float) -> list[dict]:

@@ -215,6 +215,20 @@ def mid_gap_alpha(folder: Path, structure: Structure, geom: CaseGeometry) -> np.
     return structure.mid_gap(_read_alpha(folder / "alpha.oil", structure)[0], geom.n_layers)
 
 
+def column_raster(columns: np.ndarray, structure: Structure,
+                  geom: CaseGeometry) -> metrics.Raster:
+    """A per-base-cell oil fraction (at mid-gap, or averaged across the gap) on the raster the
+    flow-pattern metrics read (:func:`metrics.raster` with the case's pattern geometry)."""
+    return metrics.raster(structure.base_x, structure.base_y, columns, pattern_geometry(geom))
+
+
+def mid_gap_raster(alpha: np.ndarray, structure: Structure,
+                   geom: CaseGeometry) -> metrics.Raster:
+    """The cell field ``alpha`` (oil fraction per cell) at mid-gap, rastered as a run's
+    metrics read it."""
+    return column_raster(structure.mid_gap(alpha, geom.n_layers), structure, geom)
+
+
 def _complete(path: Path) -> Path:
     """``path`` if OpenFOAM finished writing it (its closing banner is there), else raise:
     a truncated list can send a regex-based parser into endless backtracking."""
@@ -253,8 +267,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
 
     q_in, q_out, out_by_boundary = _in_out(oil_flux, structure, geom)
     out_by_boundary.pop(SUPPLY_PATCH, None)
-    mid = structure.mid_gap(alpha, geom.n_layers)
-    r = metrics.raster(structure.base_x, structure.base_y, mid, pattern_geometry(geom))
+    r = mid_gap_raster(alpha, structure, geom)
     pattern = metrics.flow_pattern_from_raster(r)
     pattern["bubble_volume_m3"] = _bubble_volume(r, alpha, structure, geom)
     pattern["oil_smeared_fraction"] = smeared_oil_fraction(alpha, structure.cell_volumes)
@@ -277,8 +290,7 @@ def advancing_front_cells(folder: Path, structure: Structure, geom: CaseGeometry
     the column there (the square root of its area) over its wall cell's height. A contact line
     advancing onto dry walls holds a capillary suction only where that is within some 15
     (``bench/contact_line_strip.py``). Empty without such an edge."""
-    mid = structure.mid_gap(read_alpha(folder / "alpha.oil", structure), geom.n_layers)
-    r = metrics.raster(structure.base_x, structure.base_y, mid, pattern_geometry(geom))
+    r = mid_gap_raster(read_alpha(folder / "alpha.oil", structure), structure, geom)
     points = metrics.advancing_front(r, track_half_width)
     if not len(points):
         return np.empty(0)

@@ -46,7 +46,7 @@ def meniscus_lines(case: str | Path, at: str = "last",
     else:
         time, folder = case_fields.write_near(case, at, geom.transit_time)
     alpha = case_fields.mid_gap_alpha(folder, st, geom)
-    r = metrics.raster(st.base_x, st.base_y, alpha, case_fields.pattern_geometry(geom))
+    r = case_fields.column_raster(alpha, st, geom)
     lines = []
     for line in metrics.meniscus_contours(r, threshold):
         xy = line / geom.a

@@ -49,7 +49,7 @@ def _label(image: np.ndarray, text: str):
 
 def _frame(folder: Path, t: float, geom, structure: case_fields.Structure):
     mid = case_fields.mid_gap_alpha(folder, structure, geom)
-    r = flow.raster(structure.base_x, structure.base_y, mid, case_fields.pattern_geometry(geom))
+    r = case_fields.column_raster(mid, structure, geom)
     state = flow.flow_pattern_from_raster(r)["state"]
     text = f"t = {t * 1e3:.1f} ms  ({t / geom.transit_time:.2f} transits)  state {state}"
     return _label(colour_frame(r), text)

@@ -23,7 +23,7 @@ import numpy as np
 
 from generator.case_writer import CaseGeometry
 from runs import metrics as flow
-from runs.case_fields import Structure, pattern_geometry, time_folders
+from runs.case_fields import Structure, column_raster, time_folders
 
 #: Cell fields read from the newest time (those present).
 FIELD_NAMES = ("alpha.oil", "U", "p", "p_rgh")
@@ -115,8 +115,7 @@ class Fields:
     @functools.cached_property
     def raster(self) -> flow.Raster:
         """The mid-gap oil fraction on the metrics' raster (a/20, full mirrored domain)."""
-        return flow.raster(self.structure.base_x, self.structure.base_y, self.mid_alpha,
-                           pattern_geometry(self.geom))
+        return column_raster(self.mid_alpha, self.structure, self.geom)
 
     @functools.cached_property
     def pattern(self) -> dict:
