@@ -349,12 +349,18 @@ class SideBox(BaseModel):
     the band's points with x_min <= x <= x_max and |y| >= y_min get a second band of half the
     level's cells and half its half-width. The width is set there: the meniscus meeting both
     walls spans 0.13-0.2 a in plane where the gap is 60-95 um (docs/cases.md, "Three steps
-    of one series")."""
+    of one series").
+
+    ``size`` and ``half_width`` (a) override the second band's cells and half-width, which
+    separates the sides' resolution from the rest of the meniscus's (docs/cases.md, "The
+    side band alone"); None (the default): half the level's."""
 
     model_config = _STRICT
     x_min: float = Field(ge=-200.0, le=200.0)
     x_max: float = Field(ge=-200.0, le=200.0)
     y_min: float = Field(0.0, ge=0.0, le=200.0)
+    size: float | None = Field(None, gt=0.0, le=10.0)
+    half_width: float | None = Field(None, gt=0.0, le=20.0)
 
     @model_validator(mode="after")
     def _ordered(self) -> "SideBox":

@@ -94,9 +94,10 @@ def meniscus_bands(lines: list[np.ndarray], size: float, half_width: float,
 
 
 def side_bands(bands: list[RefineBand], sides: SideBox) -> list[RefineBand]:
-    """A band of half the size and half the half-width along each run of consecutive points
-    of ``bands`` that lies in ``sides`` (the region's sides, where the meniscus sets the
-    width; :class:`~generator.case_spec.SideBox`). Runs of a single point are left out."""
+    """A band of half the size and half the half-width (or the sizes ``sides`` gives) along
+    each run of consecutive points of ``bands`` that lies in ``sides`` (the region's sides,
+    where the meniscus sets the width; :class:`~generator.case_spec.SideBox`). Runs of a
+    single point are left out."""
     out = []
     for band in bands:
         pts = np.asarray(band.points, float)
@@ -105,7 +106,8 @@ def side_bands(bands: list[RefineBand], sides: SideBox) -> list[RefineBand]:
         for i, j in zip(edges[::2], edges[1::2]):
             if j - i >= 2:
                 out.append(RefineBand(points=tuple(map(tuple, pts[i:j].tolist())),
-                                      half_width=0.5 * band.half_width, size=0.5 * band.size))
+                                      half_width=sides.half_width or 0.5 * band.half_width,
+                                      size=sides.size or 0.5 * band.size))
     return out
 
 

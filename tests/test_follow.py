@@ -47,6 +47,7 @@ def test_a_following_level_sets_its_band_and_wall_cell_on_the_common_base(level)
     ({"half_width": 0.0}, "mesh.follow.half_width"),
     ({"sides": {"x_min": 3.0, "x_max": 1.0}}, "x_min = 3 a must be below x_max = 1 a"),
     ({"sides": {"x_min": 0.0, "x_max": 1.0, "y_min": -2.0}}, "mesh.follow.sides.y_min"),
+    ({"sides": {"x_min": 0.0, "x_max": 1.0, "size": 0.0}}, "mesh.follow.sides.size"),
     ({"spacing": 0.2}, "mesh.follow.spacing"),
 ])
 def test_a_bad_follow_is_refused_naming_the_key(follow, names):
@@ -56,7 +57,8 @@ def test_a_bad_follow_is_refused_naming_the_key(follow, names):
 
 def test_side_bands_take_the_runs_of_points_in_the_box_at_half_the_cells():
     """Each run of consecutive points inside the sides' box becomes a band of half the size
-    and half the half-width; a run of one point, and the points outside, do not."""
+    and half the half-width, or of the box's own size and half-width; a run of one point,
+    and the points outside, do not."""
     pts = [(-3.0, 0.0), (-2.0, 5.5), (0.0, 6.0), (2.0, 6.5), (4.0, 4.0), (6.0, 5.5),
            (7.0, 6.0), (9.0, 6.0), (10.0, 5.2), (12.0, 0.0)]
     band = RefineBand(points=tuple(pts), half_width=1.0, size=0.24)
@@ -64,6 +66,9 @@ def test_side_bands_take_the_runs_of_points_in_the_box_at_half_the_cells():
     assert [b.points for b in sides] == [((0.0, 6.0), (2.0, 6.5)), ((6.0, 5.5), (7.0, 6.0))]
     assert all(b.size == 0.12 and b.half_width == 0.5 for b in sides)
     assert side_bands([band], SideBox(x_min=20.0, x_max=30.0)) == []
+    own = side_bands([band], SideBox(**SIDES, size=0.03, half_width=0.25))
+    assert [b.points for b in own] == [b.points for b in sides]
+    assert all(b.size == 0.03 and b.half_width == 0.25 for b in own)
 
 
 def test_cli_case_with_follow_needs_a_start_and_write_case_refuses_it(tmp_path):
