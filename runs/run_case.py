@@ -365,8 +365,9 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample,
     dt_floor = DT_COLLAPSE * geom.max_delta_t
     t_start = time.monotonic()
     n_procs = spec.run.n_procs
-    if n_procs > 1 and not (case / "processor0").is_dir():
-        runtime.run("decomposePar", ["-force"], cwd=case, log_path=case / "log.decomposePar")
+    if n_procs > 1 and not (case / "processor0").is_dir():   # a restart needs its latest time only
+        runtime.run("decomposePar", ["-force", "-latestTime"], cwd=case,
+                    log_path=case / "log.decomposePar")
     proc = runtime.popen(geom.solver, [], cwd=case, log_path=geom.log_name, n_procs=n_procs)
     reason, stopping_since, steady_kind = None, None, None
     previous = signal.getsignal(signal.SIGTERM)
@@ -409,9 +410,10 @@ def _run_locked(case, spec, geom, structure, runtime, wall_limit, on_sample,
         if proc.poll() is None:
             proc.kill()
         proc.wait()
-    if n_procs > 1:   # the last writes, then one more sample pass
+    if n_procs > 1:   # the last writes
         _reconstruct_new(case, runtime)
-        _collect(case, structure, geom, history, done, True, on_sample)
+    # one more sample pass: a run stopped by a signal left the loop before its last writes
+    _collect(case, structure, geom, history, done, True, on_sample)
     wall = time.monotonic() - t_start
     rc = proc.returncode
     if reason is None:

@@ -10,8 +10,10 @@ import json
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -1045,6 +1047,52 @@ def test_parallel_run_matches_serial(small_case, tmp_path):
     s = run_case(serial, wall_limit=300)
     assert m["simulated_time_s"] == pytest.approx(s["simulated_time_s"])
     assert m["oil_volume_m3"] == pytest.approx(s["oil_volume_m3"], rel=1e-3)
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or shutil.which("unshare") is None,
+                    reason="parallel runs of the embedded runtime need root and unshare")
+def test_parallel_restart_decomposes_its_latest_time_only(tmp_path):
+    """A reconstructed case (no processor folders: say one run serially before) restarts on
+    2 ranks from its latest time: decomposePar takes that time only, not every write, and the
+    run goes on from it with its earlier writes in its history."""
+    spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "end_time": 2e-4, "n_procs": 2}})
+    case = tmp_path / "restart"
+    write_case(spec, case)
+    first = run_case(case, wall_limit=300)
+    assert first["status"] == "finished", first
+    before = [t for t, _ in case_fields.time_folders(case)]
+    assert len(before) >= 2
+    for p in case.glob("processor*"):
+        shutil.rmtree(p)
+    with FoamFile(case / "system" / "controlDict") as f:
+        f["endTime"] = 4e-4
+    m = run_case(case, wall_limit=300)
+    assert m["status"] == "finished" and m["end_reason"] == "end_time", m
+    decomposed = [t for t, _ in case_fields.time_folders(case / "processor0")]
+    assert min(decomposed) == pytest.approx(before[-1]), (decomposed, before)
+    history = read_history(case / "history.csv")["time_s"]
+    assert history[0] == pytest.approx(before[0]) and history[-1] >= 4e-4 * (1 - 1e-6)
+
+
+def test_stopped_run_samples_its_last_writes(tmp_path):
+    """SIGTERM stops a serial run through controlDict (writeNow); its history.csv still holds
+    every time it wrote, the last one included, and it is marked interrupted, not failed."""
+    spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "end_time": 0.05}})
+    case = tmp_path / "stopped"
+    write_case(spec, case)
+    proc = subprocess.Popen([*EHLFOAM, "run", str(case), "--quiet"], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 120
+    while len(case_fields.time_folders(case)) < 3 and proc.poll() is None:
+        assert time.monotonic() < deadline, "the run wrote no three times in 120 s"
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGTERM)
+    out, _ = proc.communicate(timeout=120)
+    m = json.loads((case / "metrics.json").read_text())
+    assert m["end_reason"] == "interrupted" and m["status"] == "interrupted", (m, out)
+    written = [t for t, _ in case_fields.time_folders(case)]
+    assert len(written) >= 3 and (case / "history.csv").is_file(), (written, out)
+    assert list(read_history(case / "history.csv")["time_s"]) == pytest.approx(written)
 
 
 def test_full_domain_case_builds_and_runs(tmp_path):
