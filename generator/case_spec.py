@@ -71,8 +71,9 @@ RESOLUTIONS: dict[str, dict[str, float]] = {
 #: meniscus lies within 0.2 % of the fine level's from the medium level on, while the flooded
 #: width does not converge: the medium level rests 1.3-1.7 % wider than both others whatever
 #: it starts from, on the region's shoulders ("Resolved levels", "The medium level is
-#: wider"), and 0.3-2.8 % wider with no side band ("Bands the same all round"); the levels
-#: of :data:`RESOLUTIONS` leave the meniscus in their base cells.
+#: wider"), and 1.3-2.8 % wider with no side band, where the inlet does not converge either
+#: ("Bands the same all round", "Both fine runs on"); the levels of :data:`RESOLUTIONS` leave
+#: the meniscus in their base cells.
 FOLLOW_LEVELS: dict[str, dict[str, float]] = {
     "coarse": {"band": 0.24, "wall_cell": 3.2e-6},
     "medium": {"band": 0.12, "wall_cell": 1.6e-6},
