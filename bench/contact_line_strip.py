@@ -54,8 +54,9 @@ from foamlib import FoamFieldFile  # noqa: E402
 from bench.film_deposition import (add_strip_options, measure, options_suffix,  # noqa: E402
                                    run_or_reuse, save_rows, strip_mesh, sweep)
 from generator.case_spec import CaseSpec  # noqa: E402
-from generator.case_writer import wall_layers_fraction  # noqa: E402
+from generator.case_writer import slip_walls, wall_layers_fraction  # noqa: E402
 from generator.mesh import PolyMesh  # noqa: E402
+from generator.wall_slip import write_slip_walls  # noqa: E402
 from runs import case_fields  # noqa: E402
 from runs.foam_runtime import FoamRuntime  # noqa: E402
 
@@ -81,6 +82,8 @@ def reverse_walls(spec: CaseSpec, case: Path, mesh: PolyMesh | None = None,
             frac = wall_layers_fraction(z.min(1), z.max(1), z.max(), precursor, precursor)
             f.boundary_field["outlet"] = {"type": "inletOutlet", "inletValue": frac,
                                           "value": frac}
+    if spec.physics.wall_slip_length > 0:
+        write_slip_walls(case / "0.orig" / "U", slip_walls(spec, mesh, -u, off_track=False))
     shutil.rmtree(case / "0")
     shutil.copytree(case / "0.orig", case / "0")
 
@@ -89,11 +92,14 @@ def balance(spec: CaseSpec, gap, x_in: float, x_out: float, precursor: float = 0
     """The bridge's balance on y = 0: x (m), gap h (m), its slope, and the pressure the walls'
     drag takes off from the reservoir to each x (Pa, positive), int 12 eta u / h^2 dx; with
     a precursor layer [m] on each wall, whose oil the bridge passes on to the reservoir,
-    int 12 eta u (h - 2 precursor) / h^3 dx."""
+    int 12 eta u (h - 2 precursor) / h^3 dx. With a Navier slip length lambda on both walls
+    (physics.wall_slip_length) the walls' drag is a plug that carries no shear, and the
+    pressure drives (1 + 6 lambda / h) times the flux it drives between no-slip walls."""
     x = np.linspace(x_in, x_out, 4001)
     h = gap(x, np.zeros_like(x))
+    slip = 1.0 + 6.0 * spec.physics.wall_slip_length / h
     drop = cumulative_trapezoid(12.0 * spec.oil_viscosity * spec.speed * (h - 2 * precursor)
-                                / h**3, x, initial=0.0)
+                                / (h**3 * slip), x, initial=0.0)
     return x, h, np.gradient(h, x), drop
 
 

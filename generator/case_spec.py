@@ -177,6 +177,10 @@ class Physics(BaseModel):
             narrower and longer, holds more oil and so balances later (still 0.95 of the
             inflow out after 26 transits on coarse), with 44-48 %
             of its oil in partly filled cells ("What calms the resting meniscus").
+        wall_slip_length: [m] Navier slip on the disc and the ball (0, the default: no slip),
+            as v1912's directionMixed condition (generator/wall_slip.py): the wall's fluid
+            moves with it but for this length times the shear. A length the wall cells
+            resolve takes the moving contact line's singularity off the cells.
         ambient_pressure: [Pa, absolute] at the open boundaries (cavitating scene; the
             interface scene works in gauge pressure and adds it only to report one).
         cavitation_pressure: [Pa, absolute] the pressure floor of the cavitating scene
@@ -215,6 +219,7 @@ class Physics(BaseModel):
     interface_compression: float = Field(1.0, ge=0.0, le=4.0)
     isotropic_compression: float = Field(0.0, ge=0.0, le=1.0)
     interface_schemes: Literal["standard", "balanced"] = "standard"
+    wall_slip_length: float = Field(0.0, ge=0.0, le=1e-4)
     ambient_pressure: float = Field(1.013e5, gt=1e3, le=1e7)
     cavitation_pressure: float = Field(1e3, gt=0.0, le=1e5)
     oil_bulk_modulus: float | None = Field(None, gt=1e6, le=1e11)

@@ -29,6 +29,7 @@ from .case_spec import CaseSpec
 from .gap_source import load_gap
 from .mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
                    split_patch, wall_steps, write_polymesh)
+from .wall_slip import navier_slip, rolling_velocity, write_slip_walls
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
 META = "ehlfoam"  # the case's own folder of generator outputs
@@ -237,6 +238,26 @@ def with_supply_patch(spec: CaseSpec, mesh: PolyMesh) -> tuple[PolyMesh, np.ndar
     return split_patch(mesh, "inlet", carries, "supply"), frac[carries]
 
 
+def slip_walls(spec: CaseSpec, mesh: PolyMesh, speed: float, off_track: bool = True
+               ) -> dict[str, dict]:
+    """U's entries for the disc, at (speed, 0, 0), and the ball, rolling on it at ``speed``
+    [m/s], with the Navier slip length physics.wall_slip_length (:mod:`generator.wall_slip`)
+    where the walls come in dry: off the supply track (|y| beyond supply.track_half_width or
+    inside supply.track_inner_half_width), where the flooded region meets them in moving
+    contact lines. On the track they come in wetted and keep no slip, so the flow that sets
+    the inlet meniscus is the no-slip one. ``off_track`` False: slip on every face."""
+    lam, radius = spec.physics.wall_slip_length, spec.contact.radius
+    ball = rolling_velocity(mesh, "ball", np.array([0.0, 0.0, radius]),
+                            np.array([0.0, -speed / radius, 0.0]))
+    entries = {}
+    for patch, velocity in (("disc", np.array([speed, 0.0, 0.0])), ("ball", ball)):
+        y = np.abs(mesh.face_centres[mesh.patch_slice(patch), 1])
+        dry = ((y > spec.supply.track_half_width) | (y < spec.supply.track_inner_half_width)
+               if off_track else np.ones(len(y), bool))
+        entries[patch] = navier_slip(mesh, patch, velocity, np.where(dry, lam, 0.0))
+    return entries
+
+
 def island_velocity(spec: CaseSpec, mesh: PolyMesh) -> np.ndarray:
     """Velocity of the island faces: (u, 0, 0) projected on the wall (no through-flow)."""
     sl = mesh.patch_slice("island")
@@ -286,6 +307,8 @@ def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, fraction: np.ndarra
             del f.boundary_field["symmetry"]
     if len(supply) in (3, 6, 9):
         _write_scalar_list(case / "0.orig" / "alpha.oil", supply)
+    if spec.physics.wall_slip_length > 0:
+        write_slip_walls(case / "0.orig" / "U", slip_walls(spec, mesh, u))
     if not geom.symmetric:
         with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
             del f.boundary_field["symmetry"]
@@ -489,6 +512,21 @@ def mesh_warnings(geom: CaseGeometry) -> list[str]:
             f"mesh.size_far); docs/cases.md, \"Thinner wall cells: the ball's stair-steps\""]
 
 
+def case_mesh(spec: CaseSpec, gap) -> tuple[MeshParams, BaseMesh, PolyMesh, np.ndarray]:
+    """The mesh :func:`write_case` writes for ``spec`` on the gap h(x, y) [m]: its parameters,
+    the 2D base mesh, the extruded mesh with its supply patch, and the supply faces' oil
+    fractions."""
+    a, d = spec.a, spec.domain
+    params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
+                        island_radius=d.island_radius * a, n_layers=spec.mesh.level()["n_layers"],
+                        symmetric=d.symmetry == "half",
+                        polar_radius=None if spec.polar_radius is None
+                        else spec.polar_radius * a)
+    base = build_base_mesh(params, size_function(spec))
+    mesh, supply = with_supply_patch(spec, extrude_level(spec, base, gap))
+    return params, base, mesh, supply
+
+
 def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | None = None,
                overwrite: bool = False) -> CaseGeometry:
     """Build the case of ``spec`` in ``out`` (atomically: built in a temporary sibling folder
@@ -504,16 +542,8 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
     runtime = runtime or FoamRuntime.from_environment()
     gap, precalc = load_gap(spec.contact)
     level, a = spec.mesh.level(), spec.a
-    d = spec.domain
-    params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
-                        island_radius=d.island_radius * a, n_layers=level["n_layers"],
-                        symmetric=d.symmetry == "half",
-                        polar_radius=None if spec.polar_radius is None
-                        else spec.polar_radius * a)
-    base = build_base_mesh(params, size_function(spec))
-    mesh = extrude_level(spec, base, gap)
+    params, base, mesh, supply = case_mesh(spec, gap)
     steps = float(np.median(wall_steps(base, mesh)))
-    mesh, supply = with_supply_patch(spec, mesh)
     dx = smallest_cell_size(spec)
     dt = capillary_time_step(spec, dx)
     write_interval = _write_interval(spec)
