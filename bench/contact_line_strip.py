@@ -168,32 +168,50 @@ def cox_voinov(theta_s_deg: float, ca: float, ratio: float) -> float:
 
 #: the plot's names for spec options
 SHORT = {"n_layers": "layers", "wall_grading": "grading", "interface_schemes": "schemes",
-         "alpha_subcycles": "sub-cycles", "capillary_safety": "safety"}
+         "alpha_subcycles": "sub-cycles", "capillary_safety": "safety",
+         "isotropic_compression": "icAlpha", "wall_slip_length": "slip",
+         "contact_angle": "wall angle"}
 
 
-def plot_records(paths: list[Path], out: Path) -> None:
+def plot_records(paths: list[Path], out: Path, join: tuple[str, ...] = ()) -> None:
     """Left: each run's meniscus over time (a bridge dragged out ends where the line stops);
-    right: the apparent angle of the runs that settle, against dx, per set of wall cells."""
+    right: the apparent angle of the runs that settle, against dx, per set of wall cells, or
+    per set of options but the ``join`` ones (e.g. ``mesh.wall_cell``: the walls refined with
+    dx drawn as one series)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     rows = [r for path in paths for r in json.loads(Path(path).read_text())["rows"]]
-    walls = sorted({(r["level"], json.dumps(r["options"], sort_keys=True)) for r in rows})
+
+    def series(r: dict) -> tuple[str, str]:
+        return r["level"], json.dumps({k: v for k, v in r["options"].items() if k not in join},
+                                      sort_keys=True)
+
+    walls = sorted({series(r) for r in rows})
+    options = [json.loads(key[1]) for key in walls]
+    common = {k: v for k, v in options[0].items() if all(o.get(k) == v for o in options)}
+
+    def text(items) -> str:
+        return ", ".join(f"{SHORT.get(k.split('.')[-1], k.split('.')[-1])} {v}" for k, v in items)
+
     fig, (ax_t, ax_a) = plt.subplots(1, 2, figsize=(12, 5.6))
+    if common:
+        fig.suptitle(f"all runs: {text(common.items())}", fontsize=8)
     for i, key in enumerate(walls):
         color = plt.cm.tab10(i)
-        name = key[0] + "".join(f", {SHORT.get(k.split('.')[-1], k.split('.')[-1])} {v}"
-                                for k, v in json.loads(key[1]).items())
-        mine = sorted((r for r in rows
-                       if (r["level"], json.dumps(r["options"], sort_keys=True)) == key),
+        name = key[0] + "".join(", " + text([(k, v)]) for k, v in json.loads(key[1]).items()
+                                if k not in common)
+        mine = sorted((r for r in rows if series(r) == key),
                       key=lambda r: -r["dx_over_a"])
         for j, r in enumerate(mine):
             w = r["writes"]
             ax_t.plot([x["t_s"] for x in w], [x["x_rear_over_a"] for x in w], color=color,
                       alpha=0.35 + 0.65 * (j + 1) / len(mine), lw=1.0,
-                      label=f"{name}, dx {r['dx_over_a']:g} a")
+                      label=f"{name}, dx {r['dx_over_a']:g} a" + "".join(
+                          f", {text([(k, r['options'][k])])}" for k in join
+                          if k in r["options"]))
         settled = [r for r in mine if np.isfinite(r["apparent_angle_deg"])
                    and abs(r["meniscus_late_drift_over_a"]) < 0.05]
         ax_a.plot([r["dx_over_a"] for r in settled], [r["apparent_angle_deg"] for r in settled],
@@ -230,12 +248,15 @@ def main(argv: list[str] | None = None) -> int:
                     help="a layer on each wall coming in [m]: wetted walls instead of dry")
     ap.add_argument("--plot", default="", help="a PNG of the runs in --plot-records")
     ap.add_argument("--plot-records", nargs="+", default=[], metavar="RECORD.json")
+    ap.add_argument("--plot-join", nargs="+", default=[], metavar="KEY",
+                    help="options drawn as one series whatever their value (mesh.wall_cell)")
     ap.set_defaults(film=0.0)          # the strip's supply: none, the reservoir feeds it
     args = ap.parse_args(argv)
     if args.plot:
         if not args.plot_records:
             ap.error("--plot needs --plot-records RECORD.json ...")
-        plot_records([Path(p) for p in args.plot_records], Path(args.plot))
+        plot_records([Path(p) for p in args.plot_records], Path(args.plot),
+                     tuple(args.plot_join))
         return 0
     if not args.time > 0:
         ap.error(f"--time: {args.time} (valid range > 0)")
