@@ -38,6 +38,19 @@ def test_the_meniscus_position_and_its_apparent_angle_invert_each_other(strip):
     assert np.isnan(angle_at_meniscus(spec, table, 4 * a))
 
 
+def test_a_slip_takes_its_share_of_the_drag_off_the_balance(strip):
+    """On a gap of uniform height h, walls slipping by lambda let the pressure drive
+    (1 + 6 lambda / h) times the flux, so the drag's pressure drop is that much smaller."""
+    spec, _, a, _ = strip
+    h, lam = 30e-6, 1e-6
+    slipping = make_case_spec({**SMALL, "physics": {"wall_slip_length": lam}})
+    flat = lambda x, y: np.full_like(np.asarray(x, float), h)  # noqa: E731
+    drop = balance(spec, flat, 4 * a, 10 * a)[3][-1]
+    drop_slip = balance(slipping, flat, 4 * a, 10 * a)[3][-1]
+    assert drop == pytest.approx(12 * spec.oil_viscosity * spec.speed * 6 * a / h**2, rel=1e-9)
+    assert drop_slip == pytest.approx(drop / (1 + 6 * lam / h), rel=1e-9)
+
+
 def test_dry_walls_run_into_a_bridge_fed_by_the_reservoir(strip, tmp_path):
     spec, gap, a, mesh = strip
     case = tmp_path / "strip"
@@ -60,6 +73,29 @@ def test_dry_walls_run_into_a_bridge_fed_by_the_reservoir(strip, tmp_path):
     _, h, oil = columns(mesh, alpha)
     assert oil[0] == pytest.approx(h[0], rel=0.02)
     assert oil[-1] < 0.05 * h[-1]               # the walls come in dry
+
+
+def test_slipping_walls_drag_the_bridge_less(strip, tmp_path):
+    """The same strip with a slip of 5 um on both walls (physics.wall_slip_length): the walls
+    are Navier-slip directionMixed walls at -u on every face, and over the same 0.02 s they drag
+    the meniscus less far towards the reservoir than the no-slip walls do."""
+    spec, gap, a, mesh = strip
+    moved = {}
+    for lam in (0.0, 5e-6):
+        s = make_case_spec({**SMALL, "physics": {"wall_slip_length": lam}})
+        case = tmp_path / f"strip{lam:g}"
+        write_strip_case(s, case, mesh, x_bridge=7 * a, film=0.0, dx=0.5 * a, end_time=0.02,
+                         write_interval=0.01)
+        reverse_walls(s, case, mesh=mesh)
+        if lam:
+            disc = FoamFieldFile(case / "0" / "U").boundary_field["disc"]
+            assert disc["type"] == "directionMixed"
+            np.testing.assert_allclose(disc["refValue"], [[-s.wall_speed, 0, 0]] * len(
+                disc["refValue"]))
+        FoamRuntime.from_environment().run("interFoam", cwd=case, log_path=case / "log")
+        rows = measure(case, mesh, a, 10 * a)
+        moved[lam] = 7.0 - rows[-1]["x_rear_over_a"]
+    assert 0 < moved[5e-6] < 0.9 * moved[0.0], moved
 
 
 def test_wall_rows_read_the_stall_the_air_and_the_pressure_of_the_wall_cells(strip, tmp_path):
