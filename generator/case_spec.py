@@ -177,10 +177,14 @@ class Physics(BaseModel):
             narrower and longer, holds more oil and so balances later (still 0.95 of the
             inflow out after 26 transits on coarse), with 44-48 %
             of its oil in partly filled cells ("What calms the resting meniscus").
-        wall_slip_length: [m] Navier slip on the disc and the ball (0, the default: no slip),
-            as v1912's directionMixed condition (generator/wall_slip.py): the wall's fluid
-            moves with it but for this length times the shear. A length the wall cells
-            resolve takes the moving contact line's singularity off the cells.
+        wall_slip_length: [m] Navier slip on the disc and the ball off the supply track,
+            where they come in dry (0, the default: no slip), as v1912's directionMixed
+            condition (generator/wall_slip.py): the wall's fluid moves with it but for this
+            length times the shear, and the pressure drives (1 + 6 lambda / h) times the
+            no-slip flux. With isotropic_compression = 1, 1 um lets the wall's angle reach an
+            advancing contact line on in-plane cells of some 0.06 a and finer; on coarser
+            ones the line falls back towards the compression's 30 deg (docs/cases.md,
+            "Navier slip at the walls").
         ambient_pressure: [Pa, absolute] at the open boundaries (cavitating scene; the
             interface scene works in gauge pressure and adds it only to report one).
         cavitation_pressure: [Pa, absolute] the pressure floor of the cavitating scene
