@@ -29,7 +29,7 @@ from .case_spec import CaseSpec
 from .gap_source import load_gap
 from .mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
                    split_patch, wall_steps, write_polymesh)
-from .wall_slip import navier_slip, rolling_velocity, write_slip_walls
+from .wall_slip import navier_slip, rolling_velocity, wall_normals, write_slip_walls
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
 META = "ehlfoam"  # the case's own folder of generator outputs
@@ -260,8 +260,7 @@ def slip_walls(spec: CaseSpec, mesh: PolyMesh, speed: float, off_track: bool = T
 
 def island_velocity(spec: CaseSpec, mesh: PolyMesh) -> np.ndarray:
     """Velocity of the island faces: (u, 0, 0) projected on the wall (no through-flow)."""
-    sl = mesh.patch_slice("island")
-    n = mesh.face_areas[sl] / np.linalg.norm(mesh.face_areas[sl], axis=1, keepdims=True)
+    n = wall_normals(mesh, "island")
     u = np.array([spec.wall_speed, 0.0, 0.0])
     return u - n * (n @ u)[:, None]
 

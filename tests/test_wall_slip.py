@@ -12,7 +12,7 @@ from foamlib import FoamFieldFile
 from generator.case_spec import make_case_spec
 from generator.case_writer import case_mesh, load_spec_of, write_case
 from generator.gap_source import load_gap
-from generator.wall_slip import navier_slip, slip_fraction
+from generator.wall_slip import navier_slip, slip_fraction, wall_normals
 from runs import case_fields
 from runs.run_case import run_case
 from tiny import SMALL
@@ -39,8 +39,7 @@ def test_value_fraction_holds_the_normal_and_a_share_of_the_tangent(slip_case):
     entry = navier_slip(mesh, "ball", np.zeros(3), SLIP)
     f = slip_fraction(mesh, "ball", SLIP)
     assert 0.05 < f.min() and f.max() < 0.95        # the tiny case's cells span the slip
-    sl = mesh.patch_slice("ball")
-    n = mesh.face_areas[sl] / np.linalg.norm(mesh.face_areas[sl], axis=1, keepdims=True)
+    n = wall_normals(mesh, "ball")
     xx, xy, xz, yy, yz, zz = entry["valueFraction"].T
     vf = np.stack([np.stack([xx, xy, xz], 1), np.stack([xy, yy, yz], 1),
                    np.stack([xz, yz, zz], 1)], 1)
@@ -76,7 +75,7 @@ def test_solver_holds_the_walls_fluid_at_the_navier_slip(slip_case, tmp_path):
         walls = {p: np.asarray(f.boundary_field[p]["refValue"], float) for p in ("disc", "ball")}
     for patch in ("disc", "ball"):
         sl = mesh.patch_slice(patch)
-        n = mesh.face_areas[sl] / np.linalg.norm(mesh.face_areas[sl], axis=1, keepdims=True)
+        n = wall_normals(mesh, patch)
         dry = np.abs(mesh.face_centres[sl, 1]) > SMALL["supply"]["track_half_width"]
         assert 0 < dry.sum() < len(dry)
         rel = cells[mesh.owner[sl]] - walls[patch]
