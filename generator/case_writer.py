@@ -25,6 +25,7 @@ from ehl_precalc.outputs import atomic_write_json, atomic_write_text
 from runs.foam_runtime import FoamRuntime
 
 from . import face_oil
+from .foam_lists import fill_placeholders, placeholder
 from .case_spec import CaseSpec
 from .gap_source import load_gap
 from .mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
@@ -298,14 +299,14 @@ def _edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, fraction: np.ndarra
         f.boundary_field['"(disc|ball|island)"']["theta0"] = spec.physics.contact_angle
         if len(supply):
             f.boundary_field["supply"]["value"] = (supply if len(supply) not in (3, 6, 9)
-                                                   else _PLACEHOLDER)
+                                                   else placeholder("supply", "value"))
         if spec.fills_domain:   # oil everywhere: oil is what flows in
             f.boundary_field['"(outlet|side)"']["inletValue"] = 1.0
             f.boundary_field["inlet"]["value"] = 1.0
         if not geom.symmetric:
             del f.boundary_field["symmetry"]
     if len(supply) in (3, 6, 9):
-        _write_scalar_list(case / "0.orig" / "alpha.oil", supply)
+        fill_placeholders(case / "0.orig" / "alpha.oil", {placeholder("supply", "value"): supply})
     if spec.physics.wall_slip_length > 0:
         write_slip_walls(case / "0.orig" / "U", slip_walls(spec, mesh, u))
     if not geom.symmetric:
@@ -337,20 +338,6 @@ def _edit_thermo_fields(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
         f.boundary_field['"(inlet|outlet|side)"']["value"] = temp
         if not geom.symmetric:
             del f.boundary_field["symmetry"]
-
-
-#: foamlib (1.7) writes a scalar list of 3, 6 or 9 values as a uniform vector or tensor; such
-#: lists are written through this placeholder instead.
-_PLACEHOLDER = 7.123456789e33
-
-
-def _write_scalar_list(path: Path, values: np.ndarray) -> None:
-    text = path.read_text()
-    body = " ".join(repr(float(v)) for v in values)
-    marker = f"uniform {_PLACEHOLDER!r}"
-    if marker not in text:
-        raise RuntimeError(f"placeholder for a {len(values)}-value list not found in {path}")
-    path.write_text(text.replace(marker, f"nonuniform List<scalar> {len(values)}({body})"))
 
 
 def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:

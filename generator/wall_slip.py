@@ -24,11 +24,8 @@ from pathlib import Path
 import numpy as np
 from foamlib import FoamFieldFile
 
-from ehl_precalc.outputs import atomic_write_text
+from generator.foam_lists import fill_placeholders, placeholder
 from generator.mesh import PolyMesh
-
-#: OpenFOAM's list type for a field of each number of components.
-_LIST_TYPES = {3: "vector", 6: "symmTensor"}
 
 
 def wall_normals(mesh: PolyMesh, patch: str) -> np.ndarray:
@@ -78,12 +75,6 @@ def navier_slip(mesh: PolyMesh, patch: str, wall_velocity: np.ndarray,
             "valueFraction": sym, "value": u}
 
 
-def _list_text(values: np.ndarray) -> str:
-    """``nonuniform List<T> N((...) ...)`` of a vector (F, 3) or symmTensor (F, 6) field."""
-    rows = " ".join("(" + " ".join(repr(float(c)) for c in row) + ")" for row in values)
-    return f"nonuniform List<{_LIST_TYPES[values.shape[1]]}> {len(values)}({rows})"
-
-
 def write_slip_walls(u_file: Path, entries: dict[str, dict]) -> None:
     """Put patches' :func:`navier_slip` entries into the U file ``u_file``. foamlib writes the
     entries with a placeholder word for each list, and the lists are written here: it takes
@@ -94,12 +85,7 @@ def write_slip_walls(u_file: Path, entries: dict[str, dict]) -> None:
             words = {}
             for key, value in entry.items():
                 if isinstance(value, np.ndarray):
-                    words[key] = f"ehlfoamList_{patch}_{key}"
+                    words[key] = placeholder(patch, key)
                     lists[words[key]] = value
             f.boundary_field[patch] = {**entry, **words}
-    text = u_file.read_text()
-    for word, values in lists.items():
-        if text.count(word) != 1:
-            raise RuntimeError(f"placeholder {word} not written once in {u_file}")
-        text = text.replace(word, _list_text(values))
-    atomic_write_text(u_file, text)
+    fill_placeholders(u_file, lists)
