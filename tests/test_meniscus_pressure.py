@@ -1,0 +1,28 @@
+"""The contact angle a side meniscus's pressure jump implies (bench/meniscus_pressure.py):
+Young-Laplace across the gap and along the outline, inverted."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from bench.meniscus_pressure import apparent_angle
+
+SIGMA, GAP = 0.030, 70e-6   # N/m, m: the nominal oil, the gap beside the region's widest point
+
+
+@pytest.mark.parametrize("theta, radius", [(15.0, math.inf), (25.0, 7 * 137e-6), (60.0, 1e-3)])
+def test_the_angle_of_a_young_laplace_jump_is_recovered(theta, radius):
+    kappa = 0.0 if math.isinf(radius) else 1.0 / radius
+    p_air = 3.0
+    p_oil = p_air - 2.0 * SIGMA * math.cos(math.radians(theta)) / GAP + SIGMA * kappa
+    assert apparent_angle(p_oil, p_air, GAP, SIGMA, kappa) == pytest.approx(theta, abs=1e-9)
+
+
+def test_the_outline_curvature_counts_and_a_jump_beyond_any_angle_is_nan():
+    p_oil = -2.0 * SIGMA / GAP          # a fully wetting meniscus, straight in the plane
+    assert apparent_angle(p_oil, 0.0, GAP, SIGMA) == pytest.approx(0.0, abs=1e-6)
+    # the same jump on an outline bulging out needs more suction than any angle gives
+    assert math.isnan(apparent_angle(p_oil, 0.0, GAP, SIGMA, 1.0 / (7 * 137e-6)))
+    assert math.isnan(apparent_angle(+2.5 * SIGMA / GAP, 0.0, GAP, SIGMA))
