@@ -1,4 +1,4 @@
-"""The contact angle a side meniscus's pressure jump implies (bench/meniscus_pressure.py):
+"""The contact angle a meniscus's pressure jump implies (bench/meniscus_pressure.py):
 Young-Laplace across the gap and along the outline, inverted."""
 
 from __future__ import annotations
