@@ -25,8 +25,8 @@ from ehl_precalc.outputs import atomic_write_json, atomic_write_text
 from runs.foam_runtime import FoamRuntime
 
 from . import face_oil
-from .foam_lists import fill_placeholders, placeholder
 from .case_spec import CaseSpec
+from .foam_lists import fill_placeholders, placeholder
 from .gap_source import load_gap
 from .mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
                    split_patch, wall_steps, write_polymesh)

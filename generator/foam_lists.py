@@ -14,8 +14,8 @@ import numpy as np
 
 from ehl_precalc.outputs import atomic_write_text
 
-#: OpenFOAM's list type for each number of components per value (1: a 1D array).
-_LIST_TYPES = {1: "scalar", 3: "vector", 6: "symmTensor", 9: "tensor"}
+#: OpenFOAM's list type for each number of components per value.
+_LIST_TYPES = {3: "vector", 6: "symmTensor", 9: "tensor"}
 
 
 def placeholder(patch: str, key: str) -> str:
@@ -28,12 +28,13 @@ def list_text(values: np.ndarray) -> str:
     tensor (F, 9) field."""
     values = np.asarray(values, float)
     if values.ndim == 1:
-        return (f"nonuniform List<scalar> {len(values)}("
-                + " ".join(repr(float(v)) for v in values) + ")")
-    if values.ndim != 2 or values.shape[1] not in _LIST_TYPES:
+        kind, rows = "scalar", " ".join(repr(float(v)) for v in values)
+    elif values.ndim == 2 and values.shape[1] in _LIST_TYPES:
+        kind = _LIST_TYPES[values.shape[1]]
+        rows = " ".join("(" + " ".join(repr(float(c)) for c in row) + ")" for row in values)
+    else:
         raise ValueError(f"values: shape {values.shape} (valid: (F,) or (F, 3 | 6 | 9))")
-    rows = " ".join("(" + " ".join(repr(float(c)) for c in row) + ")" for row in values)
-    return f"nonuniform List<{_LIST_TYPES[values.shape[1]]}> {len(values)}({rows})"
+    return f"nonuniform List<{kind}> {len(values)}({rows})"
 
 
 def fill_placeholders(path: Path, lists: dict[str, np.ndarray]) -> None:
