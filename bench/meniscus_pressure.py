@@ -16,11 +16,17 @@ wall's.
 
     python bench/meniscus_pressure.py CASE [CASE ...] [--time T] [--angles 0 45 90 135 180]
         [--save NAME.json] [--note TEXT]
+    python bench/meniscus_pressure.py --plot FILE.png --records NAME.json ... [--only TEXT ...]
+        [--rays 60 75 90]
+
+``--plot`` draws the recorded runs' apparent angles on the given rays against the in-plane cell
+at the meniscus there (``--only``: the runs whose case path ends with one of the texts).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
 from pathlib import Path
@@ -32,7 +38,7 @@ from scipy.spatial import cKDTree
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from bench.common import save  # noqa: E402
+from bench.common import RESULTS, save  # noqa: E402
 from ehl_precalc.gap import GapField  # noqa: E402
 from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
 from runs.case_fields import Structure, mid_gap_alpha, time_folders  # noqa: E402
@@ -111,12 +117,60 @@ def along_rays(case: Path, time: float | None = None,
                      "laplace_Pa": laplace, "jump_over_laplace": (p_air - p_oil) / laplace,
                      "apparent_angle_deg": apparent_angle(p_oil, p_air, h_m,
                                                           physics.surface_tension)})
-    return {"case": str(case), "time_s": float(folder.name), "rays": rays}
+    return {"case": str(case), "time_s": float(folder.name),
+            "wall_angle_deg": float(physics.contact_angle), "rays": rays}
+
+
+def plot_angles(results: list[dict], out: Path, rays: tuple[float, ...] = (60, 75, 90)) -> None:
+    """The apparent angle [deg] of each run's meniscus on ``rays`` [deg] against the in-plane
+    cell there [a] (log scale, finer to the right), one colour a run and one marker a ray;
+    a jump beyond any angle is drawn as a cross at 0 deg, the wall's angle as a dotted line."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    markers = dict(zip(rays, "os^vD<>p"))
+    if not any(ray["angle_deg"] in markers and ray["meniscus_over_a"] is not None
+               for res in results for ray in res["rays"]):
+        raise ValueError(f"rays {rays}: no ray of these runs has a meniscus on them")
+    fig, ax = plt.subplots(figsize=(8.5, 5.2))
+    for i, res in enumerate(results):
+        color = plt.cm.tab10(i % 10)
+        label = "/".join(Path(res["case"]).parts[-2:]) + f" @ {res['time_s']:.4g} s"
+        for ray in res["rays"]:
+            if ray["angle_deg"] not in markers or ray["meniscus_over_a"] is None:
+                continue
+            angle = ray["apparent_angle_deg"]
+            nan = not math.isfinite(angle)
+            ax.plot(ray["cell_over_a"], 0.0 if nan else angle, "x" if nan else
+                    markers[ray["angle_deg"]], color=color, ms=7, label=label)
+            label = None
+    for ray, marker in markers.items():
+        ax.plot([], [], marker, color="0.4", ls="none", label=f"ray {ray:g} deg")
+    walls = sorted({res.get("wall_angle_deg", 15.0) for res in results})
+    for wall in walls:
+        ax.axhline(wall, color="0.5", ls=":", lw=1)
+        ax.text(0.01, wall + 0.7, f"wall {wall:g} deg", fontsize=7, color="0.4",
+                transform=ax.get_yaxis_transform())
+    ax.set_xscale("log")
+    lo, hi = ax.get_xlim()
+    ticks = [t for t in (0.0075, 0.015, 0.03, 0.06, 0.12, 0.24, 0.48, 0.96) if lo <= t <= hi]
+    ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
+    ax.minorticks_off()
+    ax.invert_xaxis()
+    ax.set_xlabel("in-plane cell at the meniscus / a (finer to the right)")
+    ax.set_ylabel("apparent angle from the jump (deg); x: beyond any angle")
+    ax.set_title("menisci's apparent angles against their cells")
+    ax.legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("cases", nargs="+", type=Path)
+    ap.add_argument("cases", nargs="*", type=Path)
     ap.add_argument("--time", type=float, help="written time [s] (default: the last)")
     ap.add_argument("--angles", nargs="+", type=float, default=[0, 45, 90, 135, 180])
     ap.add_argument("--inside", type=float, default=4.0,
@@ -125,7 +179,22 @@ def main(argv=None) -> int:
                     help="air sample a gap height and this many local cells outside it")
     ap.add_argument("--save", help="record name under bench/results/")
     ap.add_argument("--note", default="")
+    ap.add_argument("--plot", type=Path, help="draw the --records' angles into this image")
+    ap.add_argument("--records", nargs="+", default=[], help="records under bench/results/")
+    ap.add_argument("--only", nargs="+", default=[], help="runs whose case path ends with one of these")
+    ap.add_argument("--rays", nargs="+", type=float, default=[60, 75, 90])
     args = ap.parse_args(argv)
+    if args.plot:
+        results = [res for name in args.records
+                   for res in json.loads((RESULTS / name).read_text())["results"]
+                   if not args.only or any(res["case"].endswith(text) for text in args.only)]
+        if not results:
+            ap.error(f"--records {args.records} --only {args.only}: no run to draw")
+        plot_angles(results, args.plot, tuple(args.rays))
+        print(f"wrote {args.plot} ({len(results)} runs)")
+        return 0
+    if not args.cases:
+        ap.error("give CASE folders, or --plot with --records")
     out = []
     for case in args.cases:
         res = along_rays(case, args.time, tuple(args.angles), args.inside, args.outside)

@@ -26,3 +26,25 @@ def test_the_outline_curvature_counts_and_a_jump_beyond_any_angle_is_nan():
     # the same jump on an outline bulging out needs more suction than any angle gives
     assert math.isnan(apparent_angle(p_oil, 0.0, GAP, SIGMA, 1.0 / (7 * 137e-6)))
     assert math.isnan(apparent_angle(+2.5 * SIGMA / GAP, 0.0, GAP, SIGMA))
+
+
+def test_the_angles_chart_draws_every_ray_asked_for(tmp_path):
+    from bench.meniscus_pressure import plot_angles
+
+    def ray(deg, cell, angle):
+        return {"angle_deg": deg, "meniscus_over_a": 7.0, "cell_over_a": cell,
+                "apparent_angle_deg": angle}
+
+    results = [{"case": "runs/x/coarse", "time_s": 0.1, "wall_angle_deg": 15.0,
+                "rays": [ray(60, 0.24, 18.0), ray(90, 0.24, float("nan"))]},
+               {"case": "runs/x/fine", "time_s": 0.1, "wall_angle_deg": 15.0,
+                "rays": [ray(60, 0.06, 30.0), ray(90, 0.03, 35.0), ray(0, 0.06, 36.0)]}]
+    out = tmp_path / "angles.png"
+    plot_angles(results, out, rays=(60, 90))
+    import matplotlib.image
+
+    image = matplotlib.image.imread(out)
+    assert image.shape[0] > 300 and image.shape[1] > 500
+    # no run has a meniscus on the 45 deg ray: nothing to draw is an error, not an empty chart
+    with pytest.raises(ValueError, match="no ray"):
+        plot_angles(results, tmp_path / "none.png", rays=(45,))
