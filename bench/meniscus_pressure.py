@@ -181,7 +181,8 @@ def main(argv=None) -> int:
     ap.add_argument("--note", default="")
     ap.add_argument("--plot", type=Path, help="draw the --records' angles into this image")
     ap.add_argument("--records", nargs="+", default=[], help="records under bench/results/")
-    ap.add_argument("--only", nargs="+", default=[], help="runs whose case path ends with one of these")
+    ap.add_argument("--only", nargs="+", default=[],
+                    help="runs whose case path ends with one of these")
     ap.add_argument("--rays", nargs="+", type=float, default=[60, 75, 90])
     args = ap.parse_args(argv)
     if args.plot:
