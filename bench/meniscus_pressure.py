@@ -131,16 +131,16 @@ def plot_angles(results: list[dict], out: Path, rays: tuple[float, ...] = (60, 7
     import matplotlib.pyplot as plt
 
     markers = dict(zip(rays, "os^vD<>p"))
-    if not any(ray["angle_deg"] in markers and ray["meniscus_over_a"] is not None
-               for res in results for ray in res["rays"]):
+    drawn = [[ray for ray in res["rays"]
+              if ray["angle_deg"] in markers and ray["meniscus_over_a"] is not None]
+             for res in results]
+    if not any(drawn):
         raise ValueError(f"rays {rays}: no ray of these runs has a meniscus on them")
     fig, ax = plt.subplots(figsize=(8.5, 5.2))
-    for i, res in enumerate(results):
+    for i, (res, mine) in enumerate(zip(results, drawn)):
         color = plt.cm.tab10(i % 10)
         label = "/".join(Path(res["case"]).parts[-2:]) + f" @ {res['time_s']:.4g} s"
-        for ray in res["rays"]:
-            if ray["angle_deg"] not in markers or ray["meniscus_over_a"] is None:
-                continue
+        for ray in mine:
             angle = ray["apparent_angle_deg"]
             nan = not math.isfinite(angle)
             ax.plot(ray["cell_over_a"], 0.0 if nan else angle, "x" if nan else
