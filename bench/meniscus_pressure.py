@@ -121,31 +121,64 @@ def along_rays(case: Path, time: float | None = None,
             "wall_angle_deg": float(physics.contact_angle), "rays": rays}
 
 
-def plot_angles(results: list[dict], out: Path, rays: tuple[float, ...] = (60, 75, 90)) -> None:
+def group_series(results: list[dict], specs: list[str]) -> list[tuple[str, list[dict]]]:
+    """Runs grouped into series by ``LABEL=SUFFIX,SUFFIX,...`` specs, each run named by the
+    last folders of its case path, in the order the suffixes are given. A suffix that names no run is
+    an error, so that a series is never drawn short."""
+    groups = []
+    for spec in specs:
+        label, sep, names = spec.rpartition("=")
+        if not sep or not label or not names:
+            raise ValueError(f"--series {spec!r}: expected LABEL=SUFFIX,SUFFIX,...")
+        runs = []
+        for name in names.split(","):
+            tail = Path(name).parts
+            found = [res for res in results if Path(res["case"]).parts[-len(tail):] == tail]
+            if not found:
+                raise ValueError(f"--series {label!r}: no run ends with {name!r}")
+            runs += found
+        groups.append((label, runs))
+    return groups
+
+
+def plot_angles(results: list[dict], out: Path, rays: tuple[float, ...] = (60, 75, 90),
+                series: list[str] | None = None) -> None:
     """The apparent angle [deg] of each run's meniscus on ``rays`` [deg] against the in-plane
     cell there [a] (log scale, finer to the right), one colour a run and one marker a ray;
-    a jump beyond any angle is drawn as a cross at 0 deg, the wall's angle as a dotted line."""
+    a jump beyond any angle is drawn as a cross at 0 deg, the wall's angle as a dotted line.
+    With ``series`` (``group_series``' specs) one colour a series instead, each ray's points
+    of a series joined from coarse to fine, and only the series' runs drawn."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     markers = dict(zip(rays, "os^vD<>p"))
-    drawn = [[ray for ray in res["rays"]
-              if ray["angle_deg"] in markers and ray["meniscus_over_a"] is not None]
-             for res in results]
-    if not any(drawn):
+    if series:
+        groups = group_series(results, series)
+    else:
+        groups = [("/".join(Path(res["case"]).parts[-2:]) + f" @ {res['time_s']:.4g} s", [res])
+                  for res in results]
+    # each group's drawable rays: (ray, cell [a], apparent angle [deg])
+    points = [[(ray["angle_deg"], ray["cell_over_a"], ray["apparent_angle_deg"])
+               for res in runs for ray in res["rays"]
+               if ray["angle_deg"] in markers and ray["meniscus_over_a"] is not None]
+              for _, runs in groups]
+    if not any(points):
         raise ValueError(f"rays {rays}: no ray of these runs has a meniscus on them")
     fig, ax = plt.subplots(figsize=(8.5, 5.2))
-    for i, (res, mine) in enumerate(zip(results, drawn)):
+    for i, ((label, _), mine) in enumerate(zip(groups, points)):
         color = plt.cm.tab10(i % 10)
-        label = "/".join(Path(res["case"]).parts[-2:]) + f" @ {res['time_s']:.4g} s"
-        for ray in mine:
-            angle = ray["apparent_angle_deg"]
+        for deg, cell, angle in mine:
             nan = not math.isfinite(angle)
-            ax.plot(ray["cell_over_a"], 0.0 if nan else angle, "x" if nan else
-                    markers[ray["angle_deg"]], color=color, ms=7, label=label)
+            ax.plot(cell, 0.0 if nan else angle, "x" if nan else markers[deg], color=color,
+                    ms=7, label=label)
             label = None
+        for deg in markers if series else ():
+            line = sorted((cell, angle) for d, cell, angle in mine
+                          if d == deg and math.isfinite(angle))
+            if len(line) > 1:
+                ax.plot(*zip(*line), "-", color=color, lw=0.8, alpha=0.6)
     for ray, marker in markers.items():
         ax.plot([], [], marker, color="0.4", ls="none", label=f"ray {ray:g} deg")
     walls = sorted({res.get("wall_angle_deg", 15.0) for res in results})
@@ -184,6 +217,8 @@ def main(argv=None) -> int:
     ap.add_argument("--only", nargs="+", default=[],
                     help="runs whose case path ends with one of these")
     ap.add_argument("--rays", nargs="+", type=float, default=[60, 75, 90])
+    ap.add_argument("--series", nargs="+", default=[],
+                    help="LABEL=SUFFIX,SUFFIX,...: draw the runs as series, one colour each")
     args = ap.parse_args(argv)
     if args.plot:
         results = [res for name in args.records
@@ -191,7 +226,7 @@ def main(argv=None) -> int:
                    if not args.only or any(res["case"].endswith(text) for text in args.only)]
         if not results:
             ap.error(f"--records {args.records} --only {args.only}: no run to draw")
-        plot_angles(results, args.plot, tuple(args.rays))
+        plot_angles(results, args.plot, tuple(args.rays), args.series)
         print(f"wrote {args.plot} ({len(results)} runs)")
         return 0
     if not args.cases:

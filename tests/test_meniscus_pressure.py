@@ -48,3 +48,26 @@ def test_the_angles_chart_draws_every_ray_asked_for(tmp_path):
     # no run has a meniscus on the 45 deg ray: nothing to draw is an error, not an empty chart
     with pytest.raises(ValueError, match="no ray"):
         plot_angles(results, tmp_path / "none.png", rays=(45,))
+
+
+def test_series_group_runs_by_their_case_path_and_a_missing_run_is_an_error(tmp_path):
+    from bench.meniscus_pressure import group_series, plot_angles
+
+    def run(case, cell, angle):
+        return {"case": case, "time_s": 0.1, "wall_angle_deg": 43.0,
+                "rays": [{"angle_deg": 60, "meniscus_over_a": 8.0, "cell_over_a": cell,
+                          "apparent_angle_deg": angle}]}
+
+    results = [run("runs/slip/coarse", 0.12, 38.0), run("runs/noslip/coarse", 0.12, 18.0),
+               run("runs/slip/fine", 0.03, 42.0), run("runs/other/medium", 0.06, 30.0)]
+    groups = group_series(results, ["slip, 43 deg=slip/fine,slip/coarse", "no slip=noslip/coarse"])
+    assert [(label, [r["case"] for r in runs]) for label, runs in groups] == [
+        ("slip, 43 deg", ["runs/slip/fine", "runs/slip/coarse"]),
+        ("no slip", ["runs/noslip/coarse"])]
+    with pytest.raises(ValueError, match="no run ends with 'slip/medium'"):
+        group_series(results, ["slip=slip/coarse,slip/medium"])
+    with pytest.raises(ValueError, match="LABEL=SUFFIX"):
+        group_series(results, ["slip/coarse"])
+    out = tmp_path / "series.png"
+    plot_angles(results, out, rays=(60,), series=["slip=slip/coarse,slip/fine"])
+    assert out.stat().st_size > 10_000
