@@ -121,6 +121,13 @@ def along_rays(case: Path, time: float | None = None,
             "wall_angle_deg": float(physics.contact_angle), "rays": rays}
 
 
+def names_run(case: str, name: str) -> bool:
+    """Whether ``name`` (one or more folders) is the end of the ``case`` path, folder by folder
+    (``slip/coarse`` names ``runs/slip/coarse``, not ``runs/noslip/coarse``)."""
+    tail = Path(name).parts
+    return Path(case).parts[-len(tail):] == tail
+
+
 def group_series(results: list[dict], specs: list[str]) -> list[tuple[str, list[dict]]]:
     """Runs grouped into series by ``LABEL=SUFFIX,SUFFIX,...`` specs, each run named by the
     last folders of its case path, in the order the suffixes are given. A suffix that names no run is
@@ -132,8 +139,7 @@ def group_series(results: list[dict], specs: list[str]) -> list[tuple[str, list[
             raise ValueError(f"--series {spec!r}: expected LABEL=SUFFIX,SUFFIX,...")
         runs = []
         for name in names.split(","):
-            tail = Path(name).parts
-            found = [res for res in results if Path(res["case"]).parts[-len(tail):] == tail]
+            found = [res for res in results if names_run(res["case"], name)]
             if not found:
                 raise ValueError(f"--series {label!r}: no run ends with {name!r}")
             runs += found
@@ -181,7 +187,7 @@ def plot_angles(results: list[dict], out: Path, rays: tuple[float, ...] = (60, 7
                 ax.plot(*zip(*line), "-", color=color, lw=0.8, alpha=0.6)
     for ray, marker in markers.items():
         ax.plot([], [], marker, color="0.4", ls="none", label=f"ray {ray:g} deg")
-    walls = sorted({res.get("wall_angle_deg", 15.0) for res in results})
+    walls = sorted({res.get("wall_angle_deg", 15.0) for _, runs in groups for res in runs})
     for wall in walls:
         ax.axhline(wall, color="0.5", ls=":", lw=1)
         ax.text(0.01, wall + 0.7, f"wall {wall:g} deg", fontsize=7, color="0.4",
@@ -215,7 +221,7 @@ def main(argv=None) -> int:
     ap.add_argument("--plot", type=Path, help="draw the --records' angles into this image")
     ap.add_argument("--records", nargs="+", default=[], help="records under bench/results/")
     ap.add_argument("--only", nargs="+", default=[],
-                    help="runs whose case path ends with one of these")
+                    help="runs whose case path ends with one of these folders")
     ap.add_argument("--rays", nargs="+", type=float, default=[60, 75, 90])
     ap.add_argument("--series", nargs="+", default=[],
                     help="LABEL=SUFFIX,SUFFIX,...: draw the runs as series, one colour each")
@@ -223,7 +229,7 @@ def main(argv=None) -> int:
     if args.plot:
         results = [res for name in args.records
                    for res in json.loads((RESULTS / name).read_text())["results"]
-                   if not args.only or any(res["case"].endswith(text) for text in args.only)]
+                   if not args.only or any(names_run(res["case"], name) for name in args.only)]
         if not results:
             ap.error(f"--records {args.records} --only {args.only}: no run to draw")
         plot_angles(results, args.plot, tuple(args.rays), args.series)
