@@ -136,14 +136,22 @@ def test_cli_case_follows_the_meniscus_of_the_state_it_starts_from(tmp_path):
     assert again.cells == cells
 
 
-def test_the_shipped_resolved_nominal_spec_is_the_study_series_medium_step():
-    """runs/nominal_resolved.toml: the nominal case on the medium following level, with the
-    options of the study series S13 / S12 / S11 (docs/cases.md)."""
+def test_the_shipped_resolved_nominal_spec_is_the_converged_families_medium_level():
+    """runs/nominal_resolved.toml: the nominal case on the medium following level under the
+    contact-line model whose three levels converge (docs/cases.md, "The front in the side
+    cells on all three levels"): the side band round the front off the track, walls halving
+    with the side cells, 1 um slip, a 43 deg wall."""
     from generator.case_spec import load_case_spec
 
     spec = load_case_spec(ROOT / "runs" / "nominal_resolved.toml")
-    assert spec.mesh.follow is not None and spec.mesh.follow.sides == SideBox(**SIDES)
-    assert spec.mesh.follow_band == 0.12 and spec.mesh.level()["wall_cell"] == 1.6e-6
+    track = spec.supply.track_half_width / spec.a
+    assert spec.mesh.follow is not None
+    assert spec.mesh.follow.sides == SideBox(x_min=-8.0, x_max=8.0, y_min=2.2)
+    assert track < spec.mesh.follow.sides.y_min < 1.01 * track
+    assert spec.mesh.follow_band == 0.12 and spec.mesh.level()["wall_cell"] == 0.8e-6
+    assert [FOLLOW_LEVELS[lv]["wall_cell"] for lv in ("coarse", "medium", "fine")] == \
+        [1.6e-6, 0.8e-6, 0.4e-6]
+    assert (spec.physics.wall_slip_length, spec.physics.contact_angle) == (1e-6, 43.0)
     assert spec.physics.interface_schemes == "balanced"
     assert spec.physics.isotropic_compression == 1.0
     assert (spec.domain.downstream, spec.domain.side) == (20.0, 10.0)
