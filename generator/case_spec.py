@@ -71,9 +71,9 @@ RESOLUTIONS: dict[str, dict[str, float]] = {
 #: as well as across it); under that model, with the side band carried round the region's
 #: front (runs/nominal_resolved.toml), the flooded width and the inlet meniscus both
 #: converge over the three levels (docs/cases.md, "The front in the side cells on all three
-#: levels"). Without slip the cells' numerical slip is the
-#: contact lines' only slip and the width follows the side cells ("The menisci's angles are
-#: the cells'"); the levels of :data:`RESOLUTIONS` leave the meniscus in their base cells.
+#: levels"). Without slip the cells' numerical slip is the contact lines' only slip and the
+#: width follows the side cells ("The menisci's angles are the cells'"); the levels of
+#: :data:`RESOLUTIONS` leave the meniscus in their base cells.
 FOLLOW_LEVELS: dict[str, dict[str, float]] = {
     "coarse": {"band": 0.24, "wall_cell": 1.6e-6},
     "medium": {"band": 0.12, "wall_cell": 0.8e-6},
