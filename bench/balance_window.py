@@ -31,10 +31,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
-from generator.case_spec import SOLVERS  # noqa: E402
-from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
-from runs import case_fields as cf  # noqa: E402
-from runs.foam_runtime import FoamRuntime  # noqa: E402
+from ehlfoam.spec.case import SOLVERS
+from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.run import fields as cf
+from ehlfoam.foam.runtime import FoamRuntime
 
 STRIDES = (1, 2, 5, 10, 25, 50)
 

@@ -26,9 +26,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from runs.batch import BatchOptions, run_batch  # noqa: E402
-from runs.batch_results import read_results  # noqa: E402
-from runs.batch_spec import load_plan  # noqa: E402
+from ehlfoam.batch.launch import BatchOptions, run_batch
+from ehlfoam.batch.results import read_results
+from ehlfoam.batch.spec import load_plan
 
 RESULTS = ROOT / "bench" / "results"
 
@@ -55,7 +55,7 @@ def _spec(work: Path, args) -> Path:
 
 
 def _warm_precalcs(spec: Path) -> float:
-    from generator.gap_source import precalc_dir
+    from ehlfoam.gap.source import precalc_dir
 
     t0 = time.perf_counter()
     _, plan = load_plan(spec)

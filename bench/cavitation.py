@@ -27,12 +27,12 @@ sys.path.insert(0, str(ROOT))
 
 from common import solver_cpu_s  # noqa: E402
 
-from ehl_precalc.outputs import atomic_write_json  # noqa: E402
-from generator.case_spec import load_case_spec  # noqa: E402
-from generator.case_writer import load_geometry, write_case  # noqa: E402
-from runs import case_fields  # noqa: E402
-from runs.ramp import seed_from_previous  # noqa: E402
-from runs.run_case import mass_balance, run_case  # noqa: E402
+from ehlfoam.contact.outputs import atomic_write_json
+from ehlfoam.spec.case import load_case_spec
+from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.run import fields as case_fields
+from ehlfoam.seed.start import seed_from_previous
+from ehlfoam.run.monitor import mass_balance, run_case
 
 RESULTS = ROOT / "bench" / "results"
 #: every run starts from the 4 a puddle its figures were measured with (runs/nominal.toml has 5 a)

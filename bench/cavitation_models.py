@@ -31,10 +31,10 @@ from common import solver_cpu_s  # noqa: E402
 
 from foamlib import FoamFile  # noqa: E402
 
-from ehl_precalc.outputs import atomic_write_json  # noqa: E402
-from generator.case_spec import make_case_spec  # noqa: E402
-from generator.case_writer import META, write_case  # noqa: E402
-from runs.run_case import run_case  # noqa: E402
+from ehlfoam.contact.outputs import atomic_write_json
+from ehlfoam.spec.case import make_case_spec
+from ehlfoam.case.writer import META, write_case
+from ehlfoam.run.monitor import run_case
 
 RESULTS = ROOT / "bench" / "results"
 

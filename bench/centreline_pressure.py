@@ -27,8 +27,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from foamlib import FoamFieldFile  # noqa: E402
 
-from generator.case_writer import load_geometry  # noqa: E402
-from runs import case_fields  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.run import fields as case_fields
 
 #: spacing of the samples along the centre line [a]
 STEP = 0.02

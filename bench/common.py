@@ -16,9 +16,9 @@ RESULTS = Path(__file__).resolve().parent / "results"
 
 
 def _child(spec_kwargs: dict, options: dict | None, queue) -> None:
-    from ehl_precalc.multigrid import SolverOptions
-    from ehl_precalc.solver import solve
-    from ehl_precalc.spec import make_spec
+    from ehlfoam.contact.multigrid import SolverOptions
+    from ehlfoam.contact.solver import solve
+    from ehlfoam.contact.spec import make_spec
 
     solve(make_spec(**{**spec_kwargs, "grid": 65, "max_cycles": 2}))  # JIT warm-up
     spec = make_spec(**spec_kwargs)
@@ -53,7 +53,7 @@ def save(name: str, data) -> Path:
     """Write a record ``bench/results/NAME`` as JSON, atomically (an interrupted script never
     leaves half a record); ``.json`` is added to a NAME without it, so that every record is
     found by its suffix."""
-    from ehl_precalc.outputs import atomic_write_text
+    from ehlfoam.contact.outputs import atomic_write_text
 
     RESULTS.mkdir(exist_ok=True)
     path = RESULTS / (name if name.endswith(".json") else f"{name}.json")
@@ -82,7 +82,7 @@ def solver_cpu_s(case: Path) -> float | None:
 def spec_option(text: str) -> tuple[str, Any]:
     """``KEY=VALUE`` of a spec option (dotted key, e.g. ``run.max_courant=1``), the value read
     as ``ehlfoam case --set`` reads it (the spec validates it); an argparse ``type``."""
-    from runs.cli import parse_value
+    from ehlfoam.cli.main import parse_value
 
     key, sep, value = text.partition("=")
     if not sep or not key:
@@ -125,8 +125,8 @@ def apply_edits(case: Path, edits: list, solver: str = "") -> None:
 
     from foamlib import FoamFile
 
-    from ehl_precalc.outputs import atomic_write_json
-    from generator.case_writer import META, load_geometry
+    from ehlfoam.contact.outputs import atomic_write_json
+    from ehlfoam.case.writer import META, load_geometry
 
     for file, keys, value in edits:
         with FoamFile(case / file if "/" in file else case / "system" / file) as f:

@@ -53,12 +53,12 @@ from foamlib import FoamFieldFile  # noqa: E402
 
 from bench.film_deposition import (add_strip_options, measure, options_suffix,  # noqa: E402
                                    run_or_reuse, save_rows, strip_mesh, sweep)
-from generator.case_spec import CaseSpec  # noqa: E402
-from generator.case_writer import slip_walls, wall_layers_fraction  # noqa: E402
-from generator.mesh import PolyMesh  # noqa: E402
-from generator.wall_slip import write_slip_walls  # noqa: E402
-from runs import case_fields  # noqa: E402
-from runs.foam_runtime import FoamRuntime  # noqa: E402
+from ehlfoam.spec.case import CaseSpec
+from ehlfoam.case.writer import slip_walls, wall_layers_fraction
+from ehlfoam.mesh.mesh import PolyMesh
+from ehlfoam.case.wall_slip import write_slip_walls
+from ehlfoam.run import fields as case_fields
+from ehlfoam.foam.runtime import FoamRuntime
 
 
 def reverse_walls(spec: CaseSpec, case: Path, mesh: PolyMesh | None = None,

@@ -7,7 +7,7 @@ different cell sizes?
 Each snapshot's oil fraction (``ehlfoam snapshot``) is interpolated onto the mesh of each
 case named by ``--on`` the way a start on another mesh maps it (its source's oil volume
 kept; a snapshot of another contact is refused), and the flow pattern is read there from the
-mid-gap fraction as a run reads it (:mod:`runs.metrics`). Prints one table per metric, a row
+mid-gap fraction as a run reads it (:mod:`ehlfoam.metrics.pattern`). Prints one table per metric, a row
 per snapshot (the state) and a column per mesh; the spread along a row is the reading's, the
 spread down a column the states'. Writes ``bench/results/NAME.json`` (default cross_measure.json).
 """
@@ -23,18 +23,18 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import log, save  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs import metrics  # noqa: E402
-from runs.case_fields import Structure, mid_gap_raster  # noqa: E402
-from runs.case_snapshot import map_snapshot  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.metrics import pattern as metrics
+from ehlfoam.run.fields import Structure, mid_gap_raster
+from ehlfoam.seed.snapshot import map_snapshot
 
 METRICS = ("flooded_width_over_a", "inlet_meniscus_distance_over_a", "flooded_length_over_a")
 
 
 def measure_on(snapshot: Path, case: Path) -> dict:
     """The flow pattern of ``snapshot``'s state read on ``case``'s mesh, mapped as a start
-    from it would be (:func:`runs.case_snapshot.map_snapshot`: refused for another contact),
-    with how its oil was carried over (:func:`runs.field_mapping.carry_oil`)."""
+    from it would be (:func:`ehlfoam.seed.snapshot.map_snapshot`: refused for another contact),
+    with how its oil was carried over (:func:`ehlfoam.seed.mapping.carry_oil`)."""
     s = Structure.load(case)
     geom = load_geometry(case)
     fields, oil, _ = map_snapshot(case, s, snapshot, ["alpha.oil"])

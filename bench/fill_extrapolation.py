@@ -34,8 +34,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs.report.case_data import read_history  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.report.case_data import read_history
 
 #: history.csv columns read at the extrapolated balance.
 METRICS = ("flooded_width_over_a", "flooded_length_over_a", "inlet_meniscus_distance_over_a")

@@ -48,15 +48,14 @@ sys.path.insert(0, str(ROOT))
 from foamlib import FoamFieldFile  # noqa: E402
 
 from bench.common import apply_edits, edit_value_text, foam_edit, save, spec_option  # noqa: E402
-from ehl_precalc.meniscus_reynolds import landau_levich  # noqa: E402
-from generator.case_spec import CaseSpec, make_case_spec  # noqa: E402
-from generator.case_writer import (TEMPLATES, capillary_time_step,  # noqa: E402
-                                   edit_physics_dicts, edit_run_control, extrude_level)
-from generator.gap_source import load_gap  # noqa: E402
-from generator import mesh as mesh_module  # noqa: E402
-from generator.mesh import BaseMesh, PolyMesh, split_patch, write_polymesh  # noqa: E402
-from runs import case_fields  # noqa: E402
-from runs.foam_runtime import FoamRuntime  # noqa: E402
+from ehlfoam.thinfilm.model import landau_levich
+from ehlfoam.spec.case import CaseSpec, make_case_spec
+from ehlfoam.case.writer import (TEMPLATES, capillary_time_step, edit_physics_dicts, edit_run_control, extrude_level)
+from ehlfoam.gap.source import load_gap
+from ehlfoam.mesh import mesh as mesh_module
+from ehlfoam.mesh.mesh import BaseMesh, PolyMesh, split_patch, write_polymesh
+from ehlfoam.run import fields as case_fields
+from ehlfoam.foam.runtime import FoamRuntime
 
 
 #: the strip's default ends, units of a: the supply well upstream of LL's rear meniscus

@@ -28,9 +28,9 @@ sys.path.insert(0, str(ROOT))
 from bench.common import RESULTS  # noqa: E402
 from bench.fill_extrapolation import analyse  # noqa: E402
 from bench.film_deposition import FILM  # noqa: E402
-from generator.case_spec import CaseSpec, Mesh  # noqa: E402
-from generator.case_writer import load_spec_of  # noqa: E402
-from runs.run_case import rear_meniscus_cell  # noqa: E402
+from ehlfoam.spec.case import CaseSpec, Mesh
+from ehlfoam.case.writer import load_spec_of
+from ehlfoam.run.monitor import rear_meniscus_cell
 
 
 #: a run still filling (or draining) faster than this (share of the inflow kept) is too far

@@ -7,7 +7,7 @@ dissolved back and carried through the open boundaries,
     dV_gas = integral of (release - dissolution + gas in - gas out) dt,
 
 with the release and dissolution read from the written p and alpha (Kunz's terms as the
-generator writes them: runs.case_fields.gas_release and gas_dissolution) and the gas fluxes
+generator writes them: ehlfoam.run.fields.gas_release and gas_dissolution) and the gas fluxes
 as the boundaries' volume flux phi less the oil's (the monitor's oil fluxes). The error is the
 residual over the gas released in the window. The rates are sampled at the writes only
 (trapezoid), so the balance measures the reading as well as the solver; in a bath (supply mode
@@ -26,8 +26,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs import case_fields  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.run import fields as case_fields
 
 
 def balance(case: Path, start_transits: float = 0.0) -> dict:

@@ -24,10 +24,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import RESULTS, save  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs import case_fields  # noqa: E402
-from runs.case_fields import off_outlet_share  # noqa: E402
-from runs.report.case_data import read_history  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.run import fields as case_fields
+from ehlfoam.run.fields import off_outlet_share
+from ehlfoam.report.case_data import read_history
 
 #: history.csv columns summarised over the last transit.
 TRACKED = ("inlet_meniscus_distance_over_a", "flooded_length_over_a", "flooded_width_over_a",

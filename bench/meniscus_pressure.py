@@ -39,9 +39,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import RESULTS, save  # noqa: E402
-from ehl_precalc.gap import GapField  # noqa: E402
-from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
-from runs.case_fields import Structure, mid_gap_alpha, time_folders  # noqa: E402
+from ehlfoam.gap.field import GapField
+from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.run.fields import Structure, mid_gap_alpha, time_folders
 
 
 def apparent_angle(p_oil: float, p_air: float, gap: float, sigma: float,

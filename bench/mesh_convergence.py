@@ -11,7 +11,7 @@ grid convergence index of every metric over each three meshes in a row.
 At equal times each case gives its write nearest the time, or with ``--window W`` its mean over
 the writes of the W transits up to it (a resolved meniscus jitters write by write).
 
-The reading is ``runs.convergence.observed_order`` (Celik et al. 2008; its docstring has the
+The reading is ``ehlfoam.metrics.convergence.observed_order`` (Celik et al. 2008; its docstring has the
 formulas). Writes ``bench/results/NAME.json`` (default mesh_convergence.json).
 """
 
@@ -26,9 +26,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs.convergence import (METRICS, history_number, jitter, last_transit,  # noqa: E402
-                              observed_order, read_history_rows, window_mean)
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.metrics.convergence import (METRICS, history_number, jitter, last_transit, observed_order, read_history_rows, window_mean)
 
 KEYS = METRICS
 

@@ -35,8 +35,8 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from bench.plot_midgap import dress_top_view, parse_window  # noqa: E402
-from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
-from runs import case_fields  # noqa: E402
+from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.run import fields as case_fields
 
 NL = 1e-12  # m3 per nanolitre
 CLASSES = ("inside", "flooded", "drained", "outside")

@@ -4,7 +4,7 @@ last written times, read from the fields (for runs made before ``history.csv`` h
     python bench/outflow_split.py CASE [CASE ...] [--writes 11] [--save NAME.json]
 
 Reads each of the last ``--writes`` time folders as the run monitor does
-(:func:`runs.case_fields.sample`: the solver's own oil flux alphaPhi0 where it is written,
+(:func:`ehlfoam.run.fields.sample`: the solver's own oil flux alphaPhi0 where it is written,
 else phi x face alpha) and prints the mean outflow through the outlet, the side and the
 upstream boundary, and the share that leaves anywhere but through the outlet. That share
 should be near 0: oil leaving sideways means the flooded region or a wall film reached the
@@ -22,8 +22,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs import case_fields  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.run import fields as case_fields
 
 
 def outflow_split(case: str | Path, writes: int = 11) -> dict:

@@ -22,9 +22,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from generator.case_writer import load_geometry  # noqa: E402
-from runs import case_fields  # noqa: E402
-from runs.report.case_data import read_history  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.run import fields as case_fields
+from ehlfoam.report.case_data import read_history
 
 
 def main(argv=None) -> int:

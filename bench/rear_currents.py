@@ -32,11 +32,11 @@ from foamlib import FoamFieldFile
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
-from ehl_precalc.thin_film_state import load_state  # noqa: E402
+from ehlfoam.thinfilm.state import load_state
 from bench.wall_films import rear_meniscus  # noqa: E402
-from generator.case_spec import CaseSpec, load_case_spec  # noqa: E402
-from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
-from runs import case_fields  # noqa: E402
+from ehlfoam.spec.case import CaseSpec, load_case_spec
+from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.run import fields as case_fields
 
 #: the oil and air fractions that bound the interface cells
 OIL, AIR = 0.95, 0.05

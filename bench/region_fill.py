@@ -38,9 +38,9 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from bench.oil_change import columns  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs import case_fields  # noqa: E402
-from runs.convergence import history_number, read_history_rows  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.run import fields as case_fields
+from ehlfoam.metrics.convergence import history_number, read_history_rows
 
 NL = 1e-12  # m3 per nanolitre
 

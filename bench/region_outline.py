@@ -7,7 +7,7 @@ the shoulders behind it may not.
 
 For each case, the writes within W transits (default 0.1) up to T transits (default: its last
 write) are read; at each of them the mid-gap oil is rastered as the run's metrics do and the
-region's width at each station measured (:func:`runs.metrics.flooded_widths_at`), and at its
+region's width at each station measured (:func:`ehlfoam.metrics.pattern.flooded_widths_at`), and at its
 widest (the run's ``flooded_width_over_a``); ``--gap-mean`` reads the oil averaged across the
 gap instead of at mid-gap. Printed are
 the means over the writes and, for more than one case, each case's difference from the first.
@@ -25,8 +25,9 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from bench.plot_midgap import _pick  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs import case_fields, metrics  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.run import fields as case_fields
+from ehlfoam.metrics import pattern as metrics
 
 
 def outline(case: Path, at: float | None, stations_over_a: list[float],

@@ -6,7 +6,7 @@ script computes it for any finished gas-release case, older ones included (their
 geometry.json predates the release constants, which are then taken from the case's spec):
 the gas released between the first and the last write against the Bunsen coefficient times
 all the oil that was in the gap or came in, and the release rate over the last transit against
-the dissolved air the supply carries in (runs.run_case.dissolved_air_budget); and the mean and
+the dissolved air the supply carries in (ehlfoam.run.monitor.dissolved_air_budget); and the mean and
 largest of that rate ratio over all the writes.
 
     python bench/release_budget.py CASE [CASE ...] [--solubility B] [--save NAME.json]
@@ -23,9 +23,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
-from generator.case_writer import load_geometry, load_spec_of, release_geometry  # noqa: E402
-from runs import case_fields  # noqa: E402
-from runs.run_case import dissolved_air_budget  # noqa: E402
+from ehlfoam.case.writer import load_geometry, load_spec_of, release_geometry
+from ehlfoam.run import fields as case_fields
+from ehlfoam.run.monitor import dissolved_air_budget
 
 
 def budget(case: Path, solubility: float | None = None) -> dict:

@@ -25,10 +25,11 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs import case_fields, metrics  # noqa: E402
-from runs.convergence import history_number, read_history_rows  # noqa: E402
-from runs.foam_runtime import FoamRuntime  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.run import fields as case_fields
+from ehlfoam.metrics import pattern as metrics
+from ehlfoam.metrics.convergence import history_number, read_history_rows
+from ehlfoam.foam.runtime import FoamRuntime
 
 KEYS = ("inlet_meniscus_distance_over_a", "inlet_meniscus_shape", "flooded_width_over_a",
         "enclosed_bubbles")

@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import RESULTS  # noqa: E402
-from runs.convergence import fixes_a_rest  # noqa: E402
+from ehlfoam.metrics.convergence import fixes_a_rest
 
 LABELS = {"flooded_width_over_a": "flooded width / a",
           "inlet_meniscus_distance_over_a": "inlet meniscus distance / a",
@@ -42,7 +42,7 @@ def record_at(arg: str) -> tuple[dict, float]:
 
 
 def determined(r: dict) -> bool:
-    """True when a record's fit fixes its rest (``runs.convergence.fixes_a_rest`` over its
+    """True when a record's fit fixes its rest (``ehlfoam.metrics.convergence.fixes_a_rest`` over its
     longest run); else its rest is the model's guess, and the chart leaves it out."""
     return fixes_a_rest(r, max(run["t_last"] - run["t_first"] for run in r["runs"]))
 

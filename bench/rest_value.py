@@ -1,7 +1,7 @@
 """Where a metric comes to rest on one mesh, from runs that approach it before they get there:
 say one run of the mesh from above (started from a wider region) and one from below
 (started from a coarser mesh's rest). Each run's history.csv gives the metric write by
-write; ``runs.convergence.rest_value`` fits one rest value and one relaxation time to all of
+write; ``ehlfoam.metrics.convergence.rest_value`` fits one rest value and one relaxation time to all of
 them and brackets the rest between a run that ends rising and one that ends falling; each
 run fitted alone says whether one relaxation fits them all.
 
@@ -28,10 +28,10 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from bench.plot_midgap import _pick  # noqa: E402
-from generator.case_writer import load_geometry  # noqa: E402
-from runs.case_snapshot import is_snapshot, snapshot_history  # noqa: E402
-from runs.convergence import METRICS, rest_value  # noqa: E402
-from runs.report.case_data import read_history  # noqa: E402
+from ehlfoam.case.writer import load_geometry
+from ehlfoam.seed.snapshot import is_snapshot, snapshot_history
+from ehlfoam.metrics.convergence import METRICS, rest_value
+from ehlfoam.report.case_data import read_history
 
 
 def series(case: Path, key: str, t0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:

@@ -2,7 +2,7 @@
 
 Oil everywhere (scene "single-phase"), both walls rolling at u, open boundaries at p = 0, the
 island wall in place of the contact. The thin-film limit of that flow is the rigid-gap Reynolds
-equation (``ehl_precalc.rigid_reynolds``) on the same gap h(x, y), with no flux through the
+equation (``ehlfoam.thinfilm.rigid``) on the same gap h(x, y), with no flux through the
 island. Prints the pressure error on y = 0 outside the island per resolution level and writes
 ``bench/results/single_phase_check.{json,png}``.
 
@@ -25,13 +25,13 @@ sys.path.insert(0, str(ROOT))
 
 from foamlib import FoamFieldFile  # noqa: E402
 
-from ehl_precalc.rigid_reynolds import solve_rigid_reynolds  # noqa: E402
-from generator.case_spec import make_case_spec  # noqa: E402
-from generator.case_writer import load_geometry, write_case  # noqa: E402
-from generator.gap_source import load_gap  # noqa: E402
+from ehlfoam.thinfilm.rigid import solve_rigid_reynolds
+from ehlfoam.spec.case import make_case_spec
+from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.gap.source import load_gap
 from common import spec_option  # noqa: E402
-from runs import case_fields  # noqa: E402
-from runs.run_case import run_case  # noqa: E402
+from ehlfoam.run import fields as case_fields
+from ehlfoam.run.monitor import run_case
 
 RESULTS = ROOT / "bench" / "results"
 

@@ -2,13 +2,13 @@
 
     .venv/bin/python bench/stability_map.py [--grid 257|default] [--m-max 1000] [--jobs 2]
 
-Each point is an SI contact realising (M, L) (ehl_precalc.formulas.contact_from_moes, steel
+Each point is an SI contact realising (M, L) (ehlfoam.contact.formulas.contact_from_moes, steel
 on steel) with Barus viscosity and an incompressible oil, the laws under which the problem
 depends on M and L only, solved from scratch on one grid. A point is 'converged' when the
 residual and load tolerances were met, 'stagnated' when the cycles stalled within ten times
 the tolerance, 'failed' otherwise (diverged or far from converged); it records hc / NVM and
 the reason. Writes bench/results/stability_map.{json,png}; ``--grid default`` solves each point
-on the grid the solver picks by itself (ehl_precalc.solver.default_grid: 513^2 below M = 300,
+on the grid the solver picks by itself (ehlfoam.contact.solver.default_grid: 513^2 below M = 300,
 1025^2 from there) and writes stability_map_default.{json,png}; ``--m-max`` keeps the points
 with M up to that value (1000: the classic range).
 """
@@ -21,7 +21,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 
 from common import RESULTS, log, save, solve_in_subprocess
-from ehl_precalc.formulas import contact_from_moes
+from ehlfoam.contact.formulas import contact_from_moes
 
 M_VALUES = [10, 30, 100, 300, 1000, 3000, 10000, 30000]
 L_VALUES = [0, 2, 5, 10, 20]

@@ -34,11 +34,11 @@ sys.path.insert(0, str(ROOT))
 
 from foamlib import FoamFieldFile  # noqa: E402
 
-from generator.case_spec import make_case_spec  # noqa: E402
-from generator.case_writer import load_geometry, write_case  # noqa: E402
+from ehlfoam.spec.case import make_case_spec
+from ehlfoam.case.writer import load_geometry, write_case
 from common import apply_edits, edit_value_text, foam_edit, spec_option  # noqa: E402
-from runs import case_fields  # noqa: E402
-from runs.run_case import run_case  # noqa: E402
+from ehlfoam.run import fields as case_fields
+from ehlfoam.run.monitor import run_case
 
 RESULTS = ROOT / "bench" / "results"
 

@@ -20,9 +20,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from generator.case_spec import make_case_spec  # noqa: E402
-from generator.case_writer import write_case  # noqa: E402
-from runs.run_case import run_case  # noqa: E402
+from ehlfoam.spec.case import make_case_spec
+from ehlfoam.case.writer import write_case
+from ehlfoam.run.monitor import run_case
 
 RESULTS = ROOT / "bench" / "results"
 KEYS = ("state", "inlet_meniscus_distance_over_a", "inlet_meniscus_shape",

@@ -1,4 +1,4 @@
-"""The flooded region in the thin-film limit (``ehl_precalc.meniscus_reynolds``) on a series of
+"""The flooded region in the thin-film limit (``ehlfoam.thinfilm.model``) on a series of
 grids and steps: what the gap-averaged flow with Landau-Levich films makes of a case spec,
 converged on its own grid, beside the 3D interface cases.
 
@@ -32,10 +32,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save, spec_option  # noqa: E402
-from ehl_precalc.meniscus_reynolds import ThinFilmProblem, solve_thin_film  # noqa: E402
-from ehl_precalc.thin_film_state import load_state, save_state  # noqa: E402
-from generator.case_spec import CaseSpec, load_case_spec  # noqa: E402
-from generator.gap_source import load_gap  # noqa: E402
+from ehlfoam.thinfilm.model import ThinFilmProblem, solve_thin_film
+from ehlfoam.thinfilm.state import load_state, save_state
+from ehlfoam.spec.case import CaseSpec, load_case_spec
+from ehlfoam.gap.source import load_gap
 
 WORK = ROOT / "runs" / "bench" / "thin_film"
 

@@ -19,9 +19,9 @@ import argparse
 import numpy as np
 
 from common import log, save, solve_in_subprocess
-from ehl_precalc.dry import solve_dry
-from ehl_precalc.elastic import hertz_pressure
-from ehl_precalc.formulas import contact_from_moes, hamrock_dowson
+from ehlfoam.contact.dry import solve_dry
+from ehlfoam.contact.elastic import hertz_pressure
+from ehlfoam.contact.formulas import contact_from_moes, hamrock_dowson
 
 
 def dry(n: int) -> dict:
@@ -55,7 +55,7 @@ def reference(u: float, laws: dict, grid: int | None) -> dict:
     if grid:
         spec["grid"] = grid
     s = solve_in_subprocess(spec)
-    from ehl_precalc.spec import make_spec
+    from ehlfoam.contact.spec import make_spec
 
     hd_c, _ = hamrock_dowson(make_spec(**{k: v for k, v in spec.items() if k != "grid"}).contact())
     row = dict(u_mm_s=u * 1e3, laws=laws or "default (Roelands, Dowson-Higginson)", M=s["M"], L=s["L"],

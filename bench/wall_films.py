@@ -39,9 +39,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
 from bench.oil_change import columns  # noqa: E402
-from ehl_precalc.meniscus_reynolds import landau_levich  # noqa: E402
-from generator.case_writer import load_geometry, load_spec_of  # noqa: E402
-from runs import case_fields  # noqa: E402
+from ehlfoam.thinfilm.model import landau_levich
+from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.run import fields as case_fields
 
 #: where the films are read, in units of a: (name, x > ..., |y| < ..., |y| > ...)
 REGIONS = (("behind", 8.0, 4.0, 0.0), ("beside", -np.inf, np.inf, 6.0))

@@ -1,1 +1,0 @@
-"""Case generator: gap -> mesh -> OpenFOAM case files."""

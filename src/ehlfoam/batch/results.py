@@ -1,0 +1,100 @@
+"""results.csv: one row per planned case, rebuilt atomically (temporary file + rename) from the
+cases' metrics.json files, so that a kill can neither duplicate nor lose rows."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+from typing import Any
+
+from ehlfoam.contact.outputs import atomic_write_text
+
+from ehlfoam.batch.folder import CASES, RESULTS, case_status, read_metrics
+from ehlfoam.batch.spec import PlannedCase
+
+LOG = "log.interFoam"
+
+#: results.csv: these columns first, then every other scalar of metrics.json.
+FIXED_COLUMNS = ("case_id", "speed_mm_s", "temperature_C", "load_N", "supply", "disc_layer_um",
+                 "ball_layer_um", "resolution", "ramp", "ramp_step", "ramp_direction", "status",
+                 "end_reason", "reason", "state", "wall_s", "cells", "case_dir", "log")
+
+
+def _scalar(value: Any) -> bool:
+    return value is None or isinstance(value, (str, int, float, bool))
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value) if math.isfinite(value) else ""
+    return str(value)
+
+
+def solver_log(case: Path) -> str:
+    """The name of the case's solver log (log.interFoam, log.compressibleInterFoam)."""
+    try:
+        from ehlfoam.case.writer import load_geometry
+
+        return load_geometry(case).log_name
+    except Exception:  # noqa: BLE001 - not built (yet), or an older geometry.json
+        return LOG
+
+
+def result_row(batch_dir: Path, pc: PlannedCase, live: bool = False,
+               blocked: str = "") -> dict[str, Any]:
+    """The results.csv row of a planned case (typed values)."""
+    case = batch_dir / CASES / pc.id
+    m = read_metrics(case) or {}
+    status = case_status(case, live)
+    ramp = pc.ramp or {}
+    reason = m.get("reason", "") if status in ("failed", "interrupted") else ""
+    if status == "interrupted" and not reason:
+        reason = "stopped before the end of its run (rebuilt on the next run)"
+    if status == "pending" and blocked:
+        reason = blocked
+    log = solver_log(case)
+    row = {"case_id": pc.id, **pc.params, "ramp": ramp.get("name"),
+           "ramp_step": ramp.get("step"), "ramp_direction": ramp.get("direction"),
+           "status": status, "end_reason": m.get("end_reason") if status != "pending" else None,
+           "reason": reason, "state": m.get("state") if status == "finished" else None,
+           "wall_s": m.get("wall_s"), "cells": m.get("cells"),
+           "case_dir": f"{CASES}/{pc.id}",
+           "log": f"{CASES}/{pc.id}/{log}" if (case / log).is_file() else None}
+    if status in ("finished", "failed"):
+        row.update({k: v for k, v in m.items() if k not in row and _scalar(v)})
+    return row
+
+
+def results_rows(batch_dir: Path, plan: list[PlannedCase], live: set[str] = frozenset(),
+                 blocked: dict[str, str] | None = None) -> list[dict[str, Any]]:
+    """One row per planned case, in plan order."""
+    blocked = blocked or {}
+    return [result_row(batch_dir, pc, pc.id in live, blocked.get(pc.id, "")) for pc in plan]
+
+
+def write_results(batch_dir: Path, plan: list[PlannedCase], live: set[str] = frozenset(),
+                  blocked: dict[str, str] | None = None) -> list[dict[str, Any]]:
+    """Rewrite results.csv atomically from the metrics.json files; returns the rows."""
+    rows = results_rows(batch_dir, plan, live, blocked)
+    columns = list(FIXED_COLUMNS)
+    for row in rows:
+        columns += [k for k in row if k not in columns]
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({c: _cell(row.get(c)) for c in columns})
+    atomic_write_text(batch_dir / RESULTS, buf.getvalue())
+    return rows
+
+
+def read_results(batch_dir: Path) -> list[dict[str, str]]:
+    """results.csv as a list of dicts (strings)."""
+    with open(Path(batch_dir) / RESULTS, newline="") as fh:
+        return list(csv.DictReader(fh))

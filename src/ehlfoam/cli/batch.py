@@ -1,0 +1,115 @@
+"""``ehlfoam batch SPEC``: generate, run and report every case of a batch spec.
+
+Exit codes: 0 every planned case finished; 1 some case failed or is not finished; 2 bad
+input (bad spec, busy folder, a finished case with another spec; nothing built);
+130 interrupted (Ctrl-C / SIGTERM; re-run the command to resume).
+
+Registered in ``runs/cli.py`` by ``batch_cli.add_parser(sub)``; also runs on its own:
+``python -m ehlfoam.cli.batch SPEC [options]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+DESCRIPTION = (
+    "Expand a batch spec (a base case spec plus sweeps over speed, temperature, load, supply "
+    "and resolution, and speed ramps) into cases under runs/NAME/cases/, build and run the "
+    "ones not finished yet (locally, or on Dask with --scheduler / --slurm), and write "
+    "runs/NAME/results.csv, the regime map (runs/NAME/regime/) and the batch report. "
+    "Re-running resumes: finished cases are kept, failed ones re-run only with "
+    "--rerun-failed. Exit 1 if a case failed, 2 on bad input (nothing built).")
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} (valid range >= 1)")
+    return value
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The batch command's arguments (shared by the subcommand and the module's main)."""
+    p.add_argument("spec", help="batch spec TOML (e.g. examples/batches/default.toml)")
+    p.add_argument("--out", default=None,
+                   help="batch folder (default: runs/STEM/ in the working directory for STEM.toml)")
+    p.add_argument("--rerun-failed", action="store_true",
+                   help="re-run failed cases (finished cases are never recomputed)")
+    size = p.add_mutually_exclusive_group()
+    size.add_argument("--jobs", type=_positive_int, default=None,
+                      help="cases at once on this machine (each uses run.n_procs cores)")
+    size.add_argument("--cores", type=_positive_int, default=None,
+                      help="CPU budget on this machine (default: all cores); cases at once = "
+                           "cores // run.n_procs")
+    dask = p.add_mutually_exclusive_group()
+    dask.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                      help="run on a Dask distributed scheduler (e.g. tcp://host:8786); its "
+                           "workers must be started with --resources CPU=<cores>")
+    dask.add_argument("--slurm", nargs="?", const="", default=None, metavar="KEY=VALUE,...",
+                      help="run on Slurm through dask-jobqueue: cores=N,memory=16GB,"
+                           "walltime=01:00:00,queue=NAME,jobs=N[,account=NAME]")
+    p.add_argument("--dry-run", action="store_true",
+                   help="print the expanded plan and the estimated cost; build nothing")
+    p.add_argument("--no-report", action="store_true",
+                   help="skip the regime map and the batch report")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bar: one line per case event (for logs)")
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Register ``ehlfoam batch``."""
+    p = subparsers.add_parser(
+        "batch", help="run a batch of cases (sweeps, speed ramps) and map the flow regimes",
+        description=DESCRIPTION)
+    add_arguments(p)
+    p.set_defaults(func=cmd_batch)
+    return p
+
+
+def cmd_batch(args: argparse.Namespace) -> int:
+    """Run (or dry-run) the batch; exit code as in the module doc."""
+    from ehlfoam.contact.spec import SpecError
+
+    from ehlfoam.batch.launch import BatchError, BatchOptions, dry_run, run_batch
+    from ehlfoam.batch.executors import parse_slurm
+
+    try:
+        if args.dry_run:
+            print(dry_run(args.spec, Path(args.out) if args.out else None))
+            return EXIT_OK
+        slurm = parse_slurm(args.slurm) if args.slurm is not None else None
+        opts = BatchOptions(out=Path(args.out) if args.out else None, jobs=args.jobs,
+                            cores=args.cores, rerun_failed=args.rerun_failed,
+                            scheduler=args.scheduler, slurm=slurm, quiet=args.quiet,
+                            regime=not args.no_report, report=not args.no_report)
+        outcome = run_batch(args.spec, opts)
+    except (SpecError, BatchError) as err:
+        print(f"ehlfoam batch: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return outcome.exit_code
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m ehlfoam.cli.batch SPEC [options]`` (the same as ``ehlfoam batch``)."""
+    parser = argparse.ArgumentParser(prog="ehlfoam batch", description=DESCRIPTION)
+    add_arguments(parser)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:
+        return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
+    try:
+        return cmd_batch(args)
+    except KeyboardInterrupt:
+        return EXIT_INTERRUPTED
+
+
+if __name__ == "__main__":
+    sys.exit(main())

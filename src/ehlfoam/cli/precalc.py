@@ -1,0 +1,86 @@
+"""``ehlfoam precalc``: solve the EHL contact and write summary.json, solution.npz, precalc.png.
+
+Exit codes: 0 converged, 1 not converged (outputs written, ``converged: false``), 2 bad
+input (nothing written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from ehlfoam.contact.spec import PrecalcSpec, SpecError, load_spec, make_spec, valid_range
+
+_OPTIONS = {
+    # flag: (spec key, type, help with units)
+    "--load": ("load", float, "normal load F [N] (default 20)"),
+    "--speed": ("speed", float, "rolling speed u [m/s] (default 0.01)"),
+    "--temperature": ("temperature", float, "oil temperature [C] (default 40)"),
+    "--lubricant": ("lubricant", str, "tabulated oil (HVI60) or 'custom'"),
+    "--eta0": ("eta0", float, "custom oil: ambient viscosity [Pa s]"),
+    "--alpha": ("alpha", float, "custom oil: pressure-viscosity coefficient [1/Pa]"),
+    "--rho0": ("rho0", float, "custom oil: density [kg/m3]"),
+    "--radius": ("radius", float, "ball radius [m] (default 9.525e-3)"),
+    "--modulus": ("modulus", float, "reduced modulus E' [Pa] (default 1.11e11)"),
+    "--viscosity": ("viscosity", str, "roelands (default) or barus"),
+    "--density": ("density", str, "dowson-higginson (default) or incompressible"),
+    "--cavitation": ("cavitation", str, "complementarity (default, p >= 0) or twophase"),
+    "--grid": ("grid", int, "grid points per side, 2^k+1 (default: chosen from M)"),
+    "--max-cycles": ("max_cycles", int, "multigrid cycle limit (default 100)"),
+}
+
+
+def add_parser(subparsers) -> None:
+    """Register the ``precalc`` subcommand."""
+    p = subparsers.add_parser(
+        "precalc", help="solve the EHL contact (gap and film) of one operating point",
+        description="Solve the isothermal EHL point contact (Reynolds + elastic deformation + "
+                    "load balance) and write DIR/summary.json (SI units), DIR/solution.npz and "
+                    "DIR/precalc.png.")
+    p.add_argument("spec_file", nargs="?", help="TOML spec (keys as the options, without --)")
+    for flag, (_, typ, help_) in _OPTIONS.items():
+        p.add_argument(flag, type=str if typ is not str else str, default=None, help=help_)
+    p.add_argument("--out", required=True, help="output folder")
+    p.set_defaults(func=run)
+
+
+def _convert(flag: str, raw: str | None):
+    if raw is None:
+        return None
+    key, typ, _ = _OPTIONS[flag]
+    try:
+        return typ(raw)
+    except ValueError:
+        kind = "an integer" if typ is int else "a number"
+        rng = valid_range(key)
+        raise SpecError(f"invalid input: {key} = {raw!r}: not {kind}"
+                        + (f" ({rng})" if rng else "")) from None
+
+
+def spec_from_args(args: argparse.Namespace) -> PrecalcSpec:
+    values = {_OPTIONS[f][0]: _convert(f, getattr(args, f[2:].replace("-", "_")))
+              for f in _OPTIONS}
+    if args.spec_file:
+        return load_spec(args.spec_file, **values)
+    return make_spec(**values)
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        spec = spec_from_args(args)
+    except SpecError as err:
+        print(f"ehlfoam precalc: {err}", file=sys.stderr)
+        return 2
+    from ehlfoam.contact.outputs import write_all
+    from ehlfoam.contact.solver import solve
+
+    result = solve(spec)
+    summary = write_all(result, args.out)
+    keys = ("M", "L", "hc_m", "hmin_m", "p_max_Pa", "converged", "residual", "load_error",
+            "grid", "wall_s")
+    print(json.dumps({k: summary[k] for k in keys}))
+    if not result.converged:
+        print(f"ehlfoam precalc: NOT converged: {result.mg.failure}", file=sys.stderr)
+        return 1
+    return 0

@@ -1,0 +1,369 @@
+"""Full-approximation-scheme (FAS) multigrid solver of the dimensionless EHL point contact.
+
+Unknowns: the pressure P on a uniform grid (Dirichlet P = 0 on the boundary, optionally a
+zero-gradient outlet) and the film constant H0. Equations on every level:
+
+    Reynolds  L(P) = f                         (:mod:`ehlfoam.contact.reynolds`)
+    film      H = H0 + X^2/2 + Y^2/2 + W(P) + tauW   (W by DC-FFT, :mod:`ehlfoam.contact.elastic`)
+    load      h^2 sum(P) = target
+
+On the finest level f = 0, tauW = 0 and target = 2 pi / 3. The coarse levels carry the FAS
+right-hand sides (restricted residual plus coarse operator of the injected pressure), the
+FAS correction of the film (fine deformation minus coarse deformation of the injected
+pressure) and of the load. H0 is relaxed against the load on the coarsest level only.
+Full multigrid (FMG) start from a Hertzian pressure on the coarsest level.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy.ndimage import minimum_filter
+
+from ehlfoam.contact.elastic import Deformation, hertz_pressure
+from ehlfoam.contact.lubricant import PressureLaws
+from ehlfoam.contact.reynolds import relax, residual
+
+LOAD_TARGET = 2.0 * math.pi / 3.0
+
+
+@dataclass(frozen=True)
+class Domain:
+    """Computational domain in units of a and the finest grid size (points per side)."""
+
+    x_min: float
+    x_max: float
+    y_half: float
+    nx: int
+    ny: int
+
+    @property
+    def h(self) -> float:
+        return (self.x_max - self.x_min) / (self.nx - 1)
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    """Multigrid and convergence settings (dimensionless).
+
+    tol_residual: relative Reynolds residual sum|r| / sum|d(rho H)/dX| to reach.
+    tol_load: relative load-balance error to reach.
+    max_ln_eta_step: largest change of ln(eta / eta0) one relaxation sweep may make at a
+        point (see :func:`limit_viscosity_step`); 0 switches the limiter off.
+    limit_correction: hold the coarse-grid correction to the same viscosity-step limit as
+        the sweeps (used once a solve stalls).
+    stall_window, stall_ratio: the cycles stall when the best residual of the last
+        ``stall_window`` cycles is not below ``stall_ratio`` times the best of the window
+        before; the solve then goes on with :meth:`stalled` options (once).
+    """
+
+    nu1: int = 2
+    nu2: int = 1
+    gamma: int = 2
+    switch: float = 0.3
+    w_gs: float = 0.4
+    w_ja: float = 0.2
+    coarsest_min_points: int = 33
+    coarse_sweeps: int = 10
+    coarse_rounds: int = 1
+    h0_gain: float = 0.05
+    fmg_cycles: int = 2
+    max_cycles: int = 100
+    tol_residual: float = 3e-5
+    tol_load: float = 3e-5
+    max_ln_eta_step: float = 2.0
+    limit_correction: bool = False
+    stall_window: int = 8
+    stall_ratio: float = 0.7
+
+    def stalled(self) -> "SolverOptions":
+        """Options for the rest of a stalled solve (large L: a limit cycle between the pressure
+        spike's side lobes and the coarse-grid correction): half the distributive-Jacobi
+        under-relaxation, five more fine sweeps after each coarse-grid correction, and the
+        correction itself held to the viscosity-step limit."""
+        return replace(self, w_ja=0.5 * self.w_ja, nu2=self.nu2 + 5, limit_correction=True,
+                       stall_window=0)
+
+
+@dataclass
+class Problem:
+    """The dimensionless problem: Reynolds coefficient, pressure laws, boundary options."""
+
+    lam: float
+    laws: PressureLaws
+    p_floor: float = 0.0
+    neumann_outlet: bool = False
+    moes_M: float = 100.0
+
+
+class Level:
+    """One grid of the hierarchy with its FAS data."""
+
+    def __init__(self, nx: int, ny: int, x0: float, y0: float, h: float):
+        self.nx, self.ny, self.h = nx, ny, h
+        self.x = x0 + h * np.arange(nx)
+        self.y = y0 + h * np.arange(ny)
+        self.rigid = 0.5 * self.x[None, :] ** 2 + 0.5 * self.y[:, None] ** 2
+        self.deform = Deformation(nx, ny, h, h)
+        self.K0 = np.ascontiguousarray(self.deform.kernel[0, :6])
+        self.K1 = np.ascontiguousarray(self.deform.kernel[1, :6])
+        self.P = np.zeros((ny, nx))
+        self.f = np.zeros((ny, nx))
+        self.tauW = np.zeros((ny, nx))
+        self.load_target = LOAD_TARGET
+        self.work = np.zeros((ny, nx))
+
+    def load(self, P: np.ndarray) -> float:
+        return self.h * self.h * float(P.sum())
+
+    def film(self, P: np.ndarray, H0: float) -> np.ndarray:
+        return H0 + self.rigid + self.deform(P) + self.tauW
+
+    def coefficients(self, P: np.ndarray, H0: float, prob: Problem, H: np.ndarray | None = None):
+        """(H, rho, drho, eps) at pressure P; the film is computed unless given."""
+        if H is None:
+            H = self.film(P, H0)
+        rho, drho = prob.laws.rho(P)
+        eta = prob.laws.eta(P)
+        eps = rho * np.maximum(H, 0.0) ** 3 / (eta * prob.lam)
+        return H, rho, drho, eps
+
+    def residual(self, P: np.ndarray, H0: float, prob: Problem, f: np.ndarray | None = None,
+                 raw: bool = False, H: np.ndarray | None = None):
+        """(r, wedge, H) with r = f - L(P); unless ``raw``, r is zeroed where cavitation
+        holds (P = 0, r > 0: the diverging gap would pull P below 0)."""
+        H, rho, _, eps = self.coefficients(P, H0, prob, H)
+        r = np.zeros_like(P)
+        wedge = np.zeros_like(P)
+        residual(P, rho * H, eps, self.f if f is None else f, self.h, self.h, r, wedge)
+        if not raw:
+            r[(P <= prob.p_floor) & (r > 0.0)] = 0.0
+        return r, wedge, H
+
+    def relax(self, H0: float, prob: Problem, opt: SolverOptions) -> None:
+        H, rho, drho, eps = self.coefficients(self.P, H0, prob)
+        P_old = self.P.copy() if opt.max_ln_eta_step > 0.0 else None
+        deps = -eps * prob.laws.dln_eta_dP(self.P)
+        relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
+              opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet, self.work,
+              deps)
+        if P_old is not None:
+            limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step)
+            if prob.neumann_outlet:
+                self.P[:, -1] = self.P[:, -2]
+
+
+def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
+                         max_step: float) -> None:
+    """Damp a relaxation sweep where it would change the viscosity by more than a factor
+    e^max_step; updates the dimensionless pressure ``P`` in place.
+
+    The line systems hold eps = rho H^3 / (eta lambda) frozen, so where the pressure-viscosity
+    product alpha pH is large (Moes L >= 20) a step of a few tenths in P changes eta by orders
+    of magnitude and the next sweep overshoots: the pressure spike runs away to
+    exp(alpha p) overflow. Scaling the step at such points to |d ln(eta)| = max_step keeps the
+    fixed point (the limiter is inactive once the steps are small) and only slows the first
+    sweeps of a large-L solve.
+    """
+    dP = P - P_old
+    d_ln_eta = np.abs(laws.ln_eta(P) - laws.ln_eta(P_old))
+    big = d_ln_eta > max_step
+    if np.any(big):
+        P[big] = P_old[big] + dP[big] * (max_step / d_ln_eta[big])
+
+
+def _restrict_full_weighting(r: np.ndarray) -> np.ndarray:
+    rc = np.zeros(((r.shape[0] + 1) // 2, (r.shape[1] + 1) // 2))
+    rc[1:-1, 1:-1] = (
+        4.0 * r[2:-2:2, 2:-2:2]
+        + 2.0 * (r[2:-2:2, 1:-3:2] + r[2:-2:2, 3:-1:2] + r[1:-3:2, 2:-2:2] + r[3:-1:2, 2:-2:2])
+        + r[1:-3:2, 1:-3:2] + r[1:-3:2, 3:-1:2] + r[3:-1:2, 1:-3:2] + r[3:-1:2, 3:-1:2]
+    ) / 16.0
+    return rc
+
+
+def _restrict_pressure(P: np.ndarray, p_floor: float) -> np.ndarray:
+    """Coarse pressure: full weighting where the 3x3 fine neighbourhood is pressurised,
+    injection near the cavitation boundary and the domain boundary (keeps P >= 0 sharp)."""
+    Pc = P[::2, ::2].copy()
+    fw = _restrict_full_weighting(P)
+    allpos = minimum_filter(P > p_floor, size=3, mode="constant", cval=False)[::2, ::2]
+    allpos[[0, -1], :] = allpos[:, [0, -1]] = False
+    Pc[allpos] = fw[allpos]
+    return Pc
+
+
+def _prolong_bilinear(c: np.ndarray) -> np.ndarray:
+    ny, nx = 2 * c.shape[0] - 1, 2 * c.shape[1] - 1
+    f = np.zeros((ny, nx))
+    f[::2, ::2] = c
+    f[::2, 1::2] = 0.5 * (c[:, :-1] + c[:, 1:])
+    f[1::2, :] = 0.5 * (f[:-1:2, :] + f[2::2, :])
+    return f
+
+
+@dataclass
+class MGResult:
+    """Converged (or not) finest-level solution and its convergence record."""
+
+    P: np.ndarray
+    H: np.ndarray
+    H0: float
+    x: np.ndarray
+    y: np.ndarray
+    converged: bool
+    residual: float
+    load_error: float
+    cycles: int
+    history: list = field(default_factory=list)
+    wall_s: float = 0.0
+    failure: str = ""
+    #: cycle after which the stalled-solve options were used (None: never)
+    stalled_at: int | None = None
+
+
+class MultigridSolver:
+    """FAS multigrid (FMG + W-cycles) for :class:`Problem` on :class:`Domain`."""
+
+    def __init__(self, prob: Problem, dom: Domain, opt: SolverOptions | None = None):
+        self.prob, self.dom = prob, dom
+        self.opt = opt or SolverOptions()
+        nx, ny = dom.nx, dom.ny
+        h = dom.h
+        sizes = [(nx, ny, h)]
+        while (min(nx, ny) > self.opt.coarsest_min_points and (nx - 1) % 2 == 0
+               and (ny - 1) % 2 == 0):
+            nx, ny, h = (nx - 1) // 2 + 1, (ny - 1) // 2 + 1, 2 * h
+            sizes.append((nx, ny, h))
+        self.levels = [Level(n1, n2, dom.x_min, -dom.y_half, hh) for n1, n2, hh in reversed(sizes)]
+        self.H0 = 0.0
+        # the film constant reacts strongly to the load when heavily loaded: smaller steps
+        self.h0_gain = self.opt.h0_gain * (0.25 if prob.moes_M > 1000.0 else 1.0)
+
+    # --- cycle pieces -------------------------------------------------------------------
+    def _enforce_bc(self, lv: Level) -> None:
+        P = lv.P
+        P[0, :] = P[-1, :] = 0.0
+        P[:, 0] = 0.0
+        if self.prob.neumann_outlet:
+            P[:, -1] = P[:, -2]
+        else:
+            P[:, -1] = 0.0
+        np.maximum(P, self.prob.p_floor, out=P)
+
+    def _solve_coarsest(self) -> None:
+        lv = self.levels[0]
+        opt = self.opt
+        for _ in range(opt.coarse_rounds):
+            for _ in range(opt.coarse_sweeps):
+                lv.relax(self.H0, self.prob, opt)
+            self.H0 += self.h0_gain * (lv.load(lv.P) - lv.load_target)
+        for _ in range(opt.coarse_sweeps):
+            lv.relax(self.H0, self.prob, opt)
+
+    def _cycle(self, k: int) -> None:
+        if k == 0:
+            self._solve_coarsest()
+            return
+        lv, co = self.levels[k], self.levels[k - 1]
+        opt, prob = self.opt, self.prob
+        for _ in range(opt.nu1):
+            lv.relax(self.H0, prob, opt)
+        r, _, H = lv.residual(lv.P, self.H0, prob)
+        P_hat = _restrict_pressure(lv.P, prob.p_floor)
+        co.P = P_hat.copy()
+        # film FAS correction: the coarse film of P_hat is the fine film at the coarse points
+        H_hat = H[::2, ::2]
+        co.tauW = H_hat - self.H0 - co.rigid - co.deform(P_hat)
+        zero_f = np.zeros_like(P_hat)
+        r_hat, _, _ = co.residual(P_hat, self.H0, prob, f=zero_f, raw=True, H=H_hat)  # -L_H(P_hat)
+        co.f = -r_hat + _restrict_full_weighting(r)
+        co.load_target = lv.load_target + co.load(P_hat) - lv.load(lv.P)
+        for _ in range(opt.gamma if k > 1 else 1):
+            self._cycle(k - 1)
+        corr = _prolong_bilinear(co.P - P_hat)
+        # no correction inside the cavitated region, nor on its boundary
+        corr[~minimum_filter(lv.P > prob.p_floor, size=3, mode="constant", cval=False)] = 0.0
+        P_before = lv.P.copy() if opt.limit_correction else None
+        lv.P += corr
+        self._enforce_bc(lv)
+        if P_before is not None:
+            limit_viscosity_step(P_before, lv.P, prob.laws, opt.max_ln_eta_step)
+        for _ in range(opt.nu2):
+            lv.relax(self.H0, prob, opt)
+
+    def _stalled(self, history: list) -> bool:
+        """Whether the last cycles stalled (see :class:`SolverOptions`)."""
+        w = self.opt.stall_window
+        if w <= 0 or len(history) < 2 * w + 1:
+            return False
+        res = [h[1] for h in history]
+        return min(res[-w:]) > self.opt.stall_ratio * min(res[-2 * w:-w])
+
+    def measure(self) -> tuple[float, float, MGResult | None]:
+        lv = self.levels[-1]
+        r, wedge, H = lv.residual(lv.P, self.H0, self.prob)
+        denom = float(np.abs(wedge).sum()) or 1.0
+        res = float(np.abs(r).sum()) / denom
+        load_err = abs(lv.load(lv.P) - lv.load_target) / lv.load_target
+        return res, load_err, H
+
+    # --- driver ---------------------------------------------------------------------------
+    def solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
+        """Solve from a Hertzian start by FMG, or from ``P_init`` (finest grid) by cycles."""
+        t0 = time.perf_counter()
+        opt = base_opt = self.opt
+        self.H0 = H0_guess
+        history = []
+        if P_init is not None:
+            self.levels[-1].P = P_init.copy()
+            self._enforce_bc(self.levels[-1])
+            fmg_levels = []
+        else:
+            lv0 = self.levels[0]
+            X, Y = np.meshgrid(lv0.x, lv0.y)
+            lv0.P = hertz_pressure(X, Y)
+            self._enforce_bc(lv0)
+            self._solve_coarsest()
+            fmg_levels = range(1, len(self.levels))
+        # FMG: solve on each level, interpolate upwards
+        for k in fmg_levels:
+            self.levels[k].P = _prolong_bilinear(self.levels[k - 1].P)
+            self.levels[k].f[:] = 0.0
+            self.levels[k].tauW[:] = 0.0
+            self.levels[k].load_target = LOAD_TARGET
+            self._enforce_bc(self.levels[k])
+            for _ in range(opt.fmg_cycles):
+                self._cycle(k)
+        lv = self.levels[-1]
+        converged = False
+        failure = ""
+        cycles = 0
+        stalled_at = None
+        res, load_err, H = self.measure()
+        history.append((0, res, load_err, self.H0, time.perf_counter() - t0))
+        while cycles < opt.max_cycles:
+            if not np.isfinite(res) or not np.all(np.isfinite(lv.P)):
+                failure = "non-finite pressure or residual"
+                break
+            if res < opt.tol_residual and load_err < opt.tol_load:
+                converged = True
+                break
+            if self._stalled(history):
+                self.opt = opt = opt.stalled()
+                stalled_at = cycles
+            self._cycle(len(self.levels) - 1)
+            cycles += 1
+            res, load_err, H = self.measure()
+            history.append((cycles, res, load_err, self.H0, time.perf_counter() - t0))
+        self.opt = base_opt  # the stalled options hold for this solve only
+        if not converged and not failure:
+            failure = (f"not converged after {cycles} cycles: residual {res:.3g} "
+                       f"(tol {opt.tol_residual:g}), load error {load_err:.3g} (tol {opt.tol_load:g})")
+        return MGResult(P=lv.P.copy(), H=H, H0=self.H0, x=lv.x.copy(), y=lv.y.copy(),
+                        converged=converged, residual=res, load_error=load_err, cycles=cycles,
+                        history=history, wall_s=time.perf_counter() - t0, failure=failure,
+                        stalled_at=stalled_at)

@@ -1,0 +1,204 @@
+"""Solve a :class:`~ehlfoam.contact.spec.PrecalcSpec`: domain and grid choice, load continuation,
+and the SI result (summary numbers, fields, the gap).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ehlfoam.contact.formulas import Contact, moes_to_hertz_film, nijenbanning_moes_hc
+from ehlfoam.contact.multigrid import Domain, MGResult, MultigridSolver, Problem, SolverOptions
+from ehlfoam.contact.spec import P_AMBIENT_PA, PrecalcSpec
+from ehlfoam.contact.twophase import SubAmbientResult, solve_subambient
+
+#: Above this Moes M (or when a direct start fails) the solve starts from a solution at a
+#: lower M (speed ramp).
+CONTINUATION_M = 5000.0
+#: Multigrid cycles spent on each intermediate step of the speed ramp.
+RAMP_CYCLES = 4
+
+
+def default_grid(M: float) -> int:
+    """Grid points per side that keep hc within 2 % of the grid-converged value."""
+    return 513 if M < 300.0 else 1025
+
+
+def domain_for(spec: PrecalcSpec, M: float, n: int) -> Domain:
+    """Computational domain in units of a (two-phase: the thesis's x in [-2, 6], y in [-2, 2])."""
+    if spec.cavitation == "twophase":
+        return Domain(-2.0, 6.0, 2.0, 2 * n - 1, n)
+    if M < 300.0:
+        return Domain(-4.5, 1.5, 3.0, n, n)
+    if M < 1000.0:
+        return Domain(-2.5, 1.5, 2.0, n, n)
+    # heavily loaded: the inlet zone is a fraction of a; spend the points near the contact
+    return Domain(-1.8, 1.2, 1.5, n, n)
+
+
+@dataclass
+class PrecalcResult:
+    """A solved contact: the spec, the contact data, the fields and the convergence record."""
+
+    spec: PrecalcSpec
+    contact: Contact
+    domain: Domain
+    mg: MGResult
+    wall_s: float
+    continuation: list
+    subambient: SubAmbientResult | None = None
+
+    @property
+    def converged(self) -> bool:
+        return self.mg.converged
+
+    def centre_index(self) -> tuple[int, int]:
+        return int(np.argmin(np.abs(self.mg.y))), int(np.argmin(np.abs(self.mg.x)))
+
+    @property
+    def H_central(self) -> float:
+        j, i = self.centre_index()
+        return float(self.mg.H[j, i])
+
+    def cavity_length_over_a(self, below: float = 0.0) -> float:
+        """Length (units a) of the region behind the contact on y = 0 where the gauge
+        pressure is below ``below`` [Pa], from x = a to its downstream end."""
+        j, _ = self.centre_index()
+        x, p = self.mg.x, self.mg.P[j] * self.contact.p_hertz
+        neg = np.where((x >= 1.0) & (p < below))[0]
+        if neg.size == 0:
+            return 0.0
+        end = neg[0]
+        while end + 1 < len(x) and p[end + 1] < below:
+            end += 1
+        return float(x[end] - 1.0)
+
+    def summary(self) -> dict:
+        """The JSON contract (SI units, plus dimensionless groups)."""
+        c = self.contact
+        scale = c.film_scale
+        p = self.mg.P * c.p_hertz
+        out = {
+            "a_m": c.a,
+            "p_hertz_Pa": c.p_hertz,
+            "M": c.M,
+            "L": c.L,
+            "lambda": c.lam,
+            "hc_m": self.H_central * scale,
+            "hmin_m": float(self.mg.H.min()) * scale,
+            "p_max_Pa": float(p.max()),
+            "p_min_Pa": float(p.min()),
+            "h0_m": self.mg.H0 * scale,
+            "converged": bool(self.converged),
+            "residual": self.mg.residual,
+            "load_error": self.mg.load_error,
+            "cycles": self.mg.cycles,
+            # cycle from which the stalled-solve relaxation was used (None: never)
+            "stalled_at_cycle": self.mg.stalled_at,
+            "grid": [self.domain.nx, self.domain.ny],
+            "domain_over_a": [self.domain.x_min, self.domain.x_max, -self.domain.y_half,
+                              self.domain.y_half],
+            "wall_s": self.wall_s,
+            "hc_nvm_m": moes_to_hertz_film(nijenbanning_moes_hc(c.M, c.L), c.M) * scale
+            if c.L > 0 else None,
+            "failure": self.mg.failure or None,
+            "continuation_M": self.continuation,
+            "spec": self.spec.model_dump(),
+        }
+        if self.spec.cavitation == "twophase":
+            length = self.cavity_length_over_a()
+            out["cavity_length_over_a"] = length
+            out["cavity_reaches_outlet"] = bool(length >= self.domain.x_max - 1.0 - self.domain.h)
+            # where more than half the mixture's volume is gas (rho < rho0 / 2)
+            out["cavity_half_density_length_over_a"] = self.cavity_length_over_a(
+                -0.5 * self.spec.twophase_p_scale)
+            if self.subambient is not None:
+                out["subambient_newton_iterations"] = self.subambient.iterations
+        return out
+
+
+def _worse(a: MGResult, b: MGResult) -> bool:
+    """Whether attempt ``a`` is worse than ``b``: non-finite, or unconverged with a larger
+    residual."""
+    if not np.all(np.isfinite(a.P)) or not np.isfinite(a.residual):
+        return True
+    return not a.converged and a.residual > b.residual
+
+
+def _ramp(solver, prob, opt, c, factor: float, start: float, h0_guess):
+    """Step M up by ``factor`` from at most ``start`` to the contact's M, each step from the
+    previous pressure and film constant; returns the M values and the last result."""
+    steps = max(1, math.ceil(math.log(c.M / min(c.M, start)) / math.log(factor) - 1e-9))
+    M_start = c.M / factor**steps
+    ramp = [M_start * factor**k for k in range(steps + 1)]
+    P, H0, result = None, h0_guess(M_start), None
+    for k, M_k in enumerate(ramp):
+        lam_k = c.lam * (M_k / c.M) ** (-4.0 / 3.0)  # M ~ u^-3/4 at fixed load
+        solver.prob = replace(prob, lam=lam_k, moes_M=M_k)
+        solver.opt = opt if k == steps else replace(opt, max_cycles=RAMP_CYCLES)
+        result = solver.solve(H0, P_init=P)
+        if not np.all(np.isfinite(result.P)):
+            break
+        P, H0 = result.P, result.H0
+    solver.opt = opt
+    return ramp, result
+
+
+def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcResult:
+    """Solve the EHL contact of ``spec``.
+
+    Above :data:`CONTINUATION_M` (or when a direct start fails) the solution is reached by a
+    speed ramp: M is stepped up by factors of at most 2 from a directly solvable M, each step
+    starting from the previous converged pressure and film constant.
+    """
+    t0 = time.perf_counter()
+    c = spec.contact()
+    n = spec.grid or default_grid(c.M)
+    dom = domain_for(spec, c.M, n)
+    opt = options or SolverOptions(max_cycles=spec.max_cycles, tol_residual=spec.tol_residual,
+                                   tol_load=spec.tol_load)
+    twophase = spec.cavitation == "twophase"
+    # two-phase: sub-ambient pressures allowed down to absolute zero (gauge -p_ambient)
+    p_floor = -P_AMBIENT_PA / c.p_hertz if twophase else 0.0
+    prob = Problem(lam=c.lam, laws=spec.laws(), p_floor=p_floor, neumann_outlet=twophase,
+                   moes_M=c.M)
+    solver = MultigridSolver(prob, dom, opt)
+
+    def h0_guess(M: float) -> float:
+        return moes_to_hertz_film(nijenbanning_moes_hc(M, max(c.L, 1e-9)), M) - 1.0
+
+    if twophase:
+        # the contact first, p >= 0 on the two-phase domain; then the sub-ambient field
+        prob = replace(prob, p_floor=0.0, laws=replace(prob.laws, twophase_p_scale=None))
+        solver.prob = prob
+    ramp: list[float] = []
+    direct = result = None
+    if c.M <= CONTINUATION_M:
+        direct = result = solver.solve(h0_guess(c.M))
+    if result is None or not result.converged:
+        # a ramp by factors of 2 from M <= CONTINUATION_M / 4; if it blows up, a gentler one
+        # (factors of sqrt 2 from M <= CONTINUATION_M / 8)
+        for factor, start in ((2.0, CONTINUATION_M / 4), (math.sqrt(2.0), CONTINUATION_M / 8)):
+            solver = MultigridSolver(prob, dom, opt)  # fresh: no state of a failed attempt
+            ramp, attempt = _ramp(solver, prob, opt, c, factor, start, h0_guess)
+            if result is None or not _worse(attempt, result):
+                result = attempt
+            if attempt.converged:
+                break
+        if direct is not None and _worse(result, direct):
+            result, ramp = direct, []  # the ramp did not help: keep the direct attempt
+    subambient = None
+    if twophase and np.all(np.isfinite(result.P)):
+        subambient = solve_subambient(result.P, result.H, dom.h,
+                                      replace(prob, p_floor=p_floor, laws=spec.laws()))
+        result.P = subambient.P
+        if not subambient.converged:
+            result.converged = False
+            result.failure = (f"sub-ambient Newton not converged after {subambient.iterations} "
+                              f"iterations (residual {subambient.residual:.3g})")
+    return PrecalcResult(spec=spec, contact=c, domain=dom, mg=result,
+                         wall_s=time.perf_counter() - t0, continuation=ramp,
+                         subambient=subambient)

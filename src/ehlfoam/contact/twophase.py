@@ -1,0 +1,132 @@
+"""The sub-ambient (two-phase) pressure field behind the contact, one-way coupled.
+
+The thesis's two-phase model lets the pressure fall below ambient where the gap diverges,
+with a density that drops strongly there (:class:`~ehlfoam.contact.lubricant.PressureLaws`,
+``twophase_p_scale``). Those pressures are bounded by vacuum, |p| <= p_ambient ~ 2e-4 pH:
+their elastic deformation (~1e-4 of the Hertzian one) cannot move the film. So the contact
+is solved first with p >= 0 on the two-phase domain (zero-gradient outlet); then, with the
+film H and the pressurised zone (P > ``p_fixed``) held, the Reynolds equation with the
+two-phase density is solved for P in the rest of the domain by Newton's method on a sparse
+Jacobian (scipy), with P >= vacuum as an active-set constraint.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ehlfoam.contact.multigrid import Problem
+from ehlfoam.contact.reynolds import residual
+
+
+@dataclass
+class SubAmbientResult:
+    P: np.ndarray
+    converged: bool
+    iterations: int
+    residual: float
+
+
+def _coefficients(P, H, prob: Problem):
+    rho, drho = prob.laws.rho(P)
+    eps = rho * np.maximum(H, 0.0) ** 3 / (prob.laws.eta(P) * prob.lam)
+    return rho, drho, eps
+
+
+def _jacobian(P, H, rho, drho, eps, h, unknown):
+    """Sparse d(L)/dP on the unknown points (eps frozen; wedge and density derivative exact)."""
+    ny, nx = P.shape
+    idx = -np.ones(P.shape, dtype=np.int64)
+    jj, ii = np.nonzero(unknown)
+    idx[jj, ii] = np.arange(jj.size)
+    rows, cols, vals = [], [], []
+
+    def add(rr, cc_j, cc_i, v):
+        col = idx[cc_j, cc_i]
+        ok = col >= 0
+        rows.append(rr[ok])
+        cols.append(col[ok])
+        vals.append(v[ok])
+
+    r = idx[jj, ii]
+    e0 = eps[jj, ii]
+    ex_m = 0.5 * (eps[jj, ii - 1] + e0) / h**2
+    ex_p = 0.5 * (eps[jj, np.minimum(ii + 1, nx - 1)] + e0) / h**2
+    ey_m = 0.5 * (eps[jj - 1, ii] + e0) / h**2
+    ey_p = 0.5 * (eps[jj + 1, ii] + e0) / h**2
+    second = ii >= 2
+    c1 = np.where(second, 1.5, 1.0)
+    c2 = np.where(second, -2.0, -1.0)
+    c3 = np.where(second, 0.5, 0.0)
+    neumann = ii == nx - 2  # ghost P[:, -1] = P[:, -2]
+    diag = -(ex_m + ex_p + ey_m + ey_p) + np.where(neumann, ex_p, 0.0) - c1 * H[jj, ii] * drho[jj, ii] / h
+    add(r, jj, ii, diag)
+    add(r, jj, ii - 1, ex_m - c2 * H[jj, ii - 1] * drho[jj, ii - 1] / h)
+    i2 = np.maximum(ii - 2, 0)
+    add(r, jj, i2, np.where(second, -c3 * H[jj, i2] * drho[jj, i2] / h, 0.0))
+    add(r, jj, np.minimum(ii + 1, nx - 1), np.where(neumann, 0.0, ex_p))
+    add(r, jj - 1, ii, ey_m)
+    add(r, jj + 1, ii, ey_p)
+    n = jj.size
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, n))
+
+
+def solve_subambient(P0: np.ndarray, H: np.ndarray, h: float, prob: Problem,
+                     p_fixed: float = 1e-3, tol: float = 1e-8, max_iter: int = 200) -> SubAmbientResult:
+    """Newton solve of the sub-ambient pressure with the pressurised zone and the film held.
+
+    Args:
+        P0: the p >= 0 solution on the two-phase domain (units pH), zero-gradient outlet.
+        H: its film (units a^2/R), held fixed.
+        h: grid spacing (units a).
+        prob: the two-phase problem (density law with ``twophase_p_scale``, ``p_floor`` at
+            vacuum, ``neumann_outlet``).
+        p_fixed: points with P0 above this are held (units pH).
+        tol: convergence on max |residual| relative to max |wedge term|.
+    """
+    P = P0.copy()
+    ny, nx = P.shape
+    interior = np.zeros(P.shape, dtype=bool)
+    interior[1:-1, 1:-1] = True  # with a zero-gradient outlet the last column is a ghost
+    free = interior & (P0 <= p_fixed)
+    at_floor = np.zeros_like(free)
+    r = np.zeros_like(P)
+    wedge = np.zeros_like(P)
+    f0 = np.zeros_like(P)
+    def evaluate(P):
+        rho, drho, eps = _coefficients(P, H, prob)
+        residual(P, rho * H, eps, f0, h, h, r, wedge)
+        # active set: at vacuum where the equation would pull P lower still
+        unknown = free & ~((P <= prob.p_floor) & (r > 0.0))
+        merit = float(np.sqrt(np.sum(r[unknown] ** 2)))
+        return rho, drho, eps, unknown, merit
+
+    def project(P):
+        P = np.maximum(P, prob.p_floor)
+        if prob.neumann_outlet:
+            P[:, -1] = P[:, -2]
+        return P
+
+    res = np.inf
+    rho, drho, eps, unknown, merit = evaluate(P)
+    scale = float(np.abs(wedge[free]).max()) or 1.0
+    for it in range(1, max_iter + 1):
+        res = float(np.abs(r[unknown]).max()) / scale if unknown.any() else 0.0
+        if res < tol:
+            return SubAmbientResult(P=P, converged=True, iterations=it - 1, residual=res)
+        J = _jacobian(P, H, rho, drho, eps, h, unknown)
+        step = np.zeros_like(P)
+        step[unknown] = spla.spsolve(J.tocsc(), r[unknown])
+        # backtracking on the residual norm (the density law has a kink at ambient)
+        for damping in (1.0, 0.5, 0.25, 0.125, 0.0625):
+            trial = project(P + damping * step)
+            t_rho, t_drho, t_eps, t_unknown, t_merit = evaluate(trial)
+            if t_merit < merit:
+                break
+        P, rho, drho, eps, unknown, merit = trial, t_rho, t_drho, t_eps, t_unknown, t_merit
+    res = float(np.abs(r[unknown]).max()) / scale if unknown.any() else 0.0
+    return SubAmbientResult(P=P, converged=res < tol, iterations=max_iter, residual=res)

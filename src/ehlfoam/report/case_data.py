@@ -1,0 +1,257 @@
+"""What a case folder holds, read without ever failing: spec, geometry, metrics, history,
+the solver log's tail and the precalc summary.
+
+A report must work for a case that finished, failed, was interrupted, is still running or
+never ran; whatever is missing or unreadable is recorded in :attr:`CaseInfo.problems` and
+the rest is still shown.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ehlfoam.case.writer import META, CaseGeometry
+
+#: Lines of the solver log shown for a case that did not finish.
+LOG_TAIL_LINES = 30
+#: A log written to within this many seconds counts as a live run [s].
+LIVE_LOG_S = 600.0
+#: metrics.json status values that mean the run is over and fine.
+FINISHED = "finished"
+
+
+@dataclass
+class CaseInfo:
+    """Everything about a case except its fields (see :mod:`ehlfoam.report.fields`).
+
+    ``status``: "finished", "failed", "interrupted", "running", "stopped" (a log but no
+    result) or "not run". ``history``: history.csv as columns (SI; ``state`` as text), or
+    None. ``problems``: human-readable notes on what could not be read.
+    """
+
+    path: Path
+    name: str
+    geom: CaseGeometry | None
+    spec: Any                 # ehlfoam.spec.case.CaseSpec or None
+    spec_dict: dict
+    metrics: dict
+    history: dict[str, np.ndarray] | None
+    status: str
+    status_detail: str
+    log_path: Path | None
+    log_tail: list[str]
+    log_header: dict[str, str]
+    precalc: dict | None
+    problems: list[str] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        """The run finished (steady or at its time limit)."""
+        return self.status == FINISHED
+
+    @property
+    def a(self) -> float | None:
+        """Hertzian contact radius [m]."""
+        if self.geom is not None:
+            return self.geom.a
+        value = self.metrics.get("a_m")
+        return float(value) if value else None
+
+    @property
+    def solver(self) -> str:
+        """The OpenFOAM application of the case."""
+        return getattr(self.geom, "solver", None) or "interFoam"
+
+    @property
+    def scene(self) -> str:
+        """"interface", "single-phase" or "cavitating"."""
+        return str(self.spec_dict.get("scene", "interface"))
+
+
+def _read_json(path: Path, problems: list[str]) -> dict | None:
+    try:
+        return json.loads(path.read_text())
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError) as exc:
+        problems.append(f"{path.name}: unreadable ({exc})")
+        return None
+
+
+def load_geometry_tolerant(case: Path, problems: list[str]) -> CaseGeometry | None:
+    """The case's :class:`CaseGeometry`; keys unknown to this version are ignored."""
+    data = _read_json(case / META / "geometry.json", problems)
+    if data is None:
+        problems.append("ehlfoam/geometry.json missing: not a generated case?")
+        return None
+    names = {f.name for f in dataclasses.fields(CaseGeometry)}
+    try:
+        return CaseGeometry(**{k: v for k, v in data.items() if k in names})
+    except TypeError as exc:
+        problems.append(f"ehlfoam/geometry.json: {exc}")
+        return None
+
+
+def _load_spec(case: Path, problems: list[str]) -> tuple[Any, dict]:
+    raw = _read_json(case / META / "spec.json", problems) or {}
+    if not raw:
+        return None, {}
+    try:
+        from ehlfoam.spec.case import CaseSpec
+
+        return CaseSpec.model_validate(raw), raw
+    except Exception as exc:  # a spec written by another version: show the raw values
+        problems.append(f"ehlfoam/spec.json does not validate here ({type(exc).__name__})")
+        return None, raw
+
+
+_FLAGS = {"True": True, "False": False}
+
+
+def read_history(path: Path) -> dict[str, np.ndarray] | None:
+    """history.csv as columns: floats (NaN for empty cells), ``state`` as text, and the
+    flags written as True/False (``wake_open``, ``inlet_meniscus_at_rim``, ...) as Python
+    booleans (None for empty cells), so that a written "False" does not read as true."""
+    try:
+        with open(path, newline="") as fh:
+            return history_columns(list(csv.DictReader(fh)))
+    except FileNotFoundError:
+        return None
+
+
+def history_columns(rows: list[dict[str, str]]) -> dict[str, np.ndarray] | None:
+    """The rows of a history.csv (``csv.DictReader``'s) as :func:`read_history`'s columns;
+    None for no rows."""
+    if not rows:
+        return None
+    out: dict[str, np.ndarray] = {}
+    for key in rows[0]:
+        values = [r.get(key) or "" for r in rows]
+        if key == "state":
+            out[key] = np.array(values, dtype=object)
+            continue
+        if set(values) & _FLAGS.keys() and set(values) <= _FLAGS.keys() | {"", "None"}:
+            out[key] = np.array([_FLAGS.get(v) for v in values], dtype=object)
+            continue
+        try:
+            out[key] = np.array([float(v) if v not in ("", "None") else math.nan for v in values])
+        except ValueError:
+            out[key] = np.array(values, dtype=object)
+    return out
+
+
+def tail_lines(path: Path, n: int = LOG_TAIL_LINES, chunk: int = 65536) -> list[str]:
+    """The last ``n`` lines of a (possibly huge) text file, reading only its end."""
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(0, os.SEEK_END)
+            size = fh.tell()
+            fh.seek(max(0, size - chunk))
+            data = fh.read()
+    except OSError:
+        return []
+    lines = data.decode("utf-8", "replace").splitlines()
+    if size > chunk and lines:
+        lines = lines[1:]          # the first line is cut
+    return lines[-n:]
+
+
+def log_header(path: Path) -> dict[str, str]:
+    """Build, Exec, Case, nProcs... from the banner at the top of an OpenFOAM log."""
+    out: dict[str, str] = {}
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096).decode("utf-8", "replace")
+    except OSError:
+        return out
+    for line in head.splitlines():
+        key, sep, value = line.partition(":")
+        key = key.strip()
+        if sep and key in ("Build", "Exec", "Case", "nProcs", "Date", "Time", "Host"):
+            out.setdefault(key, value.strip())
+    return out
+
+
+def find_log(case: Path, geom: CaseGeometry | None) -> Path | None:
+    """The solver log: ``log.<solver>`` of the geometry, else any ``log.*Foam``."""
+    names = [getattr(geom, "log_name", None) if geom else None, "log.interFoam",
+             "log.compressibleInterFoam"]
+    for name in names:
+        if name and (case / name).is_file():
+            return case / name
+    logs = sorted(case.glob("log.*Foam"), key=lambda p: p.stat().st_mtime)
+    return logs[-1] if logs else None
+
+
+def _status(metrics: dict | None, log: Path | None) -> tuple[str, str]:
+    """(status, a sentence about it)."""
+    age = time.time() - log.stat().st_mtime if log and log.exists() else None
+    if metrics is None:
+        if log is None:
+            return "not run", "The case has not been run (no metrics.json, no solver log)."
+        if age is not None and age < LIVE_LOG_S:
+            return "running", (f"No metrics.json yet; the solver log was written "
+                               f"{age:.0f} s ago.")
+        return "stopped", ("No metrics.json: the run stopped before writing its results "
+                           "(killed?).")
+    status = str(metrics.get("status") or "unknown")
+    reason = metrics.get("end_reason")
+    if status == FINISHED:
+        steady = "steady state reached" if metrics.get("steady") else \
+            f"not steady (ended at {reason})"
+        return status, f"The run finished: {steady}."
+    if status == "running":
+        live = (f"the solver log was written {age:.0f} s ago" if age is not None
+                else "no solver log yet")
+        if age is not None and age > LIVE_LOG_S:
+            return "stopped", (f"metrics.json says running but {live}: the run stopped "
+                               "without writing its results.")
+        return status, f"The run is still going ({live}); this report shows the last write."
+    if status == "failed":
+        return status, f"The run FAILED ({reason or 'unknown reason'})."
+    if status == "interrupted":
+        return status, "The run was interrupted (Ctrl-C or SIGTERM) before its end."
+    return status, f"Run status: {status}."
+
+
+def load_case(case: str | os.PathLike) -> CaseInfo:
+    """Read everything about the case folder ``case`` except the fields. Never raises for a
+    missing or broken file (see :attr:`CaseInfo.problems`); raises FileNotFoundError only if
+    ``case`` is not a folder."""
+    case = Path(case)
+    if not case.is_dir():
+        raise FileNotFoundError(f"{case}: no such case folder")
+    problems: list[str] = []
+    geom = load_geometry_tolerant(case, problems)
+    spec, spec_dict = _load_spec(case, problems)
+    metrics = _read_json(case / "metrics.json", problems)
+    log = find_log(case, geom)
+    status, detail = _status(metrics, log)
+    try:
+        history = read_history(case / "history.csv")
+    except (OSError, csv.Error) as exc:
+        problems.append(f"history.csv unreadable ({exc})")
+        history = None
+    tail = tail_lines(log) if log else []
+    if not tail and metrics and metrics.get("log_tail"):
+        tail = list(metrics["log_tail"])
+    precalc = _read_json(case / "precalc" / "summary.json", problems)
+    spec_name = str(spec_dict.get("name") or "")
+    name = case.resolve().name if case.name in ("", ".") else case.name
+    if spec_name and spec_name not in (name, "case", "test"):
+        name = f"{name} ({spec_name})"
+    return CaseInfo(path=case, name=name, geom=geom, spec=spec, spec_dict=spec_dict,
+                    metrics=metrics or {}, history=history, status=status,
+                    status_detail=detail, log_path=log, log_tail=tail,
+                    log_header=log_header(log) if log else {}, precalc=precalc,
+                    problems=problems)

@@ -1,0 +1,38 @@
+"""A thin-film state on disc: the grid, oil and pressure of a ``ThinFilmSolution``.
+
+``bench/thin_film_region.py`` writes one per run (``.npz``); it starts the next run of the
+thin-film model (``--start``), and a 3D case can start from it (``ehlfoam case --start-from
+STATE.npz``, :mod:`ehlfoam.seed.thin_film`): the model reaches the flooded region's balance in
+minutes where a 3D run from a puddle takes hours.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ehlfoam.thinfilm.model import Grid, ThinFilmSolution
+
+
+def save_state(sol: ThinFilmSolution, path: str | Path) -> None:
+    """Write the cell centres x, y [m], gaps h [m], ``flooded``, oil content c [m], pressure
+    p [Pa] and the menisci's fills of ``sol`` to ``path`` (.npz)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(path, x=sol.grid.x, y=sol.grid.y, h=sol.grid.h, flooded=sol.flooded,
+                        content=sol.content, p=sol.p,
+                        fill=np.zeros(sol.flooded.shape) if sol.fill is None else sol.fill)
+
+
+def load_state(path: str | Path) -> ThinFilmSolution:
+    """A state written by ``save_state``, enough of it to start a run from (its grid's cells,
+    gaps and oil) and to read its flow: its pressure (NaN throughout in a state written before
+    states kept it) and its menisci's fills (None there)."""
+    d = np.load(path)
+    grid = Grid(x=d["x"], y=d["y"], h=d["h"], hx=np.empty((0, 0)), hy=np.empty((0, 0)),
+                h_side=np.empty(0), island=np.isnan(d["h"]))
+    return ThinFilmSolution(grid=grid, p=d["p"] if "p" in d else np.full(d["h"].shape, np.nan),
+                            content=d["content"], flooded=d["flooded"], time=0.0, steps=0,
+                            flux_in=0.0, flux_out=0.0, steady=False, island_radius=0.0,
+                            fill=d["fill"] if "fill" in d else None)
