@@ -27,7 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from common import solver_cpu_s  # noqa: E402
 
-from ehlfoam.contact.outputs import atomic_write_json
+from ehlfoam._io import atomic_write_json
 from ehlfoam.spec.case import load_case_spec
 from ehlfoam.case.writer import load_geometry, write_case
 from ehlfoam.run import fields as case_fields

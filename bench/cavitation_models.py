@@ -31,7 +31,7 @@ from common import solver_cpu_s  # noqa: E402
 
 from foamlib import FoamFile  # noqa: E402
 
-from ehlfoam.contact.outputs import atomic_write_json
+from ehlfoam._io import atomic_write_json
 from ehlfoam.spec.case import make_case_spec
 from ehlfoam.case.writer import META, write_case
 from ehlfoam.run.monitor import run_case

@@ -53,7 +53,7 @@ def save(name: str, data) -> Path:
     """Write a record ``bench/results/NAME`` as JSON, atomically (an interrupted script never
     leaves half a record); ``.json`` is added to a NAME without it, so that every record is
     found by its suffix."""
-    from ehlfoam.contact.outputs import atomic_write_text
+    from ehlfoam._io import atomic_write_text
 
     RESULTS.mkdir(exist_ok=True)
     path = RESULTS / (name if name.endswith(".json") else f"{name}.json")
@@ -125,7 +125,7 @@ def apply_edits(case: Path, edits: list, solver: str = "") -> None:
 
     from foamlib import FoamFile
 
-    from ehlfoam.contact.outputs import atomic_write_json
+    from ehlfoam._io import atomic_write_json
     from ehlfoam.case.writer import META, load_geometry
 
     for file, keys, value in edits:

@@ -319,7 +319,7 @@ def test_slurm_cluster_is_configured_for_mpi_cases():
         cluster.close()
     for text in ("--cpus-per-task=4", "-p short", "-t 00:30:00", "--resources CPU=4"):
         assert text in script, script
-    from ehlfoam.contact.spec import SpecError
+    from ehlfoam.errors import SpecError
 
     with pytest.raises(SpecError, match="KEY=VALUE"):
         parse_slurm("nodes=3")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from ehlfoam.contact.spec import SpecError
+from ehlfoam.errors import SpecError
 from ehlfoam.batch.spec import expand, load_plan, parse_batch_spec
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -42,7 +42,7 @@ def _plan(data: dict):
     ({"sweep": {"supply": [-1]}}, ["supply.disc_layer = -1e-06", "valid range 0 <= "]),
     ({"sweep": {"resolution": ["ultra"]}}, ["mesh.resolution = 'ultra'", "'coarse'"]),
     ({"base": {"mesh": {"levels": 3}}, "sweep": {"speed_mm_s": [5]}},
-     ["base: invalid case spec: mesh.levels: unknown parameter"]),
+     ["base: invalid case spec: mesh.levels: unknown key"]),
     ({"sweep": {"speed_mm_s": {"start": 5, "stop": 25}}}, ["a range needs start, stop"]),
 ])
 def test_bad_specs_name_key_value_and_range(data, expected):
@@ -134,7 +134,7 @@ def test_tracked_specs_are_valid(path):
     """Every spec under runs/ that the docs tell users to run is a valid case spec, or a batch
     spec that expands into valid case specs: a renamed or retired key fails here, not in a
     user's hands."""
-    from ehlfoam.contact.spec import read_toml
+    from ehlfoam._io import read_toml
     from ehlfoam.spec.case import load_case_spec
 
     data = read_toml(path)

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from foamlib import FoamFieldFile, FoamFile
 
-from ehlfoam.contact.spec import SpecError
+from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import make_case_spec
 from ehlfoam.case.writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_time_step, load_geometry, load_spec_of, mesh_warnings, write_case)
 from ehlfoam.run import fields as case_fields
@@ -50,7 +50,7 @@ def _copy(case: Path, tmp_path: Path) -> Path:
 # ------------------------------------------------------------ bad input
 @pytest.mark.parametrize("table, text, expected", [
     ("[contact]\nspeed = -0.01\n", "contact.speed = -0.01", "valid range 0 < contact.speed"),
-    ("[supply]\nlayer = 1e-6\n", "supply.layer: unknown parameter", "disc_layer"),
+    ("[supply]\nlayer = 1e-6\n", "supply.layer: unknown key", "disc_layer"),
     ("[mesh]\nresolution = \"ultra\"\n", "mesh.resolution = 'ultra'", "'coarse', 'medium' or 'fine'"),
     ("[domain]\nisland_radius = 9.0\n", "island_radius = 9 a", "nearest boundary"),
     ("[mesh]\npolar_radius = 7.9\n", "mesh.polar_radius = 7.9 a", "(1.5, 7.6] a"),
@@ -227,7 +227,7 @@ def test_a_refinement_box_refines_the_free_quads_inside_it():
     assert np.median(s1[inside(c1)]) == pytest.approx(0.2, rel=0.2)
     assert np.median(s0[inside(c0)]) > 2.5 * 0.2
     assert np.median(s1[upstream(c1)]) == pytest.approx(np.median(s0[upstream(c0)]), rel=0.05)
-    with pytest.raises(SpecError, match=r"mesh.refine.0: y_min = 5 a must be below y_max = 4.5"):
+    with pytest.raises(SpecError, match=r"mesh.refine\[0\]: y_min = 5 a must be below y_max = 4.5"):
         make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": [{**box, "y_min": 5.0}]}})
 
 
@@ -286,9 +286,9 @@ def test_a_band_refines_the_free_quads_along_its_line():
     assert on_band.sum() > 20
     assert np.median(cell[on_band]) == pytest.approx(0.2, rel=0.25)
     assert np.median(cell[c[:, 0] > 4.0]) > 3 * 0.2
-    for bad, text in (({**band, "points": [[1.0, 2.0]]}, r"mesh.refine.0.points = \[\[1.0, 2.0\]\]"),
+    for bad, text in (({**band, "points": [[1.0, 2.0]]}, r"mesh.refine\[0\].points = \[\[1.0, 2.0\]\]"),
                       ({**band, "points": [[1.0, -2.0], [3.0, 4.0]]}, r"point \(1, -2\) a"),
-                      ({**band, "half_width": 0.0}, r"mesh.refine.0.half_width = 0.0.*valid range")):
+                      ({**band, "half_width": 0.0}, r"mesh.refine\[0\].half_width = 0.0.*valid range")):
         with pytest.raises(SpecError, match=text):
             make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": [bad]}})
 

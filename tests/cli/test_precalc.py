@@ -18,7 +18,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ehlfoam.contact.spec import SpecError, load_spec, make_spec
+from ehlfoam.errors import SpecError
+
+from ehlfoam.contact.spec import load_spec, make_spec
 from ehlfoam.cli.main import main
 
 REPO = Path(__file__).resolve().parents[2]

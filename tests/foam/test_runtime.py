@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from ehlfoam.foam.runtime import (GOOD_BUILD_MAX_ERROR, BuildCheck, FoamConfigError, FoamError, FoamRuntime, FoamRuntimeMissing, check_build, default_cache_dir, parse_velocity_error)
+from ehlfoam.foam.runtime import (GOOD_BUILD_MAX_ERROR, BuildCheck, FoamConfigError, FoamError, FoamRuntime, FoamRuntimeMissing, check_build, parse_velocity_error)
+from ehlfoam.paths import cache_dir
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -28,7 +29,7 @@ def runtime() -> FoamRuntime:
 
 @pytest.fixture(scope="session")
 def embedded() -> FoamRuntime:
-    rt = FoamRuntime.embedded(default_cache_dir() / "openfoam-trixie")
+    rt = FoamRuntime.embedded(cache_dir() / "openfoam-trixie")
     if os.environ.get("EHLFOAM_FOAM", "embedded") != "embedded":
         try:
             rt.ensure_present()
@@ -177,12 +178,6 @@ def test_embedded_library_path_is_real(embedded: FoamRuntime) -> None:
     assert dirs and all(Path(d).is_dir() for d in dirs)
     assert len({os.path.realpath(d) for d in dirs}) == len(dirs)
     assert str(embedded.root / "usr/lib") in dirs
-
-
-def test_default_cache_dir() -> None:
-    assert default_cache_dir({"EHLFOAM_CACHE": "/c"}) == Path("/c")
-    assert default_cache_dir({"XDG_CACHE_HOME": "/x", "HOME": "/h"}) == Path("/x/ehlfoam")
-    assert default_cache_dir({"HOME": "/h"}) == Path("/h/.cache/ehlfoam")
 
 
 def test_bad_kind_is_config_error() -> None:

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ehlfoam.contact.spec import SpecError
+from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import (FOLLOW_BASE, FOLLOW_LEVELS, FOLLOW_POLAR_RADIUS, RefineBand, SideBox, make_case_spec)
 from ehlfoam.case.writer import load_geometry, write_case
 from ehlfoam.seed.band import side_bands

@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from ehlfoam.contact.outputs import atomic_write_json, atomic_write_text
+from ehlfoam._io import atomic_write_json, atomic_write_text
 
 from ehlfoam.batch.folder import CASES, LOCKS, SPEC_COPY, case_status, file_lock, read_metrics
 from ehlfoam.batch.spec import PlannedCase, load_plan
@@ -47,17 +47,19 @@ def plan_index(batch_dir: Path) -> dict[str, PlannedCase]:
 @contextmanager
 def _precalc_lock(contact) -> Iterator[None]:
     """One process at a time solves a given contact (the cache is per machine)."""
-    from ehlfoam.gap.source import cache_root, spec_key
+    from ehlfoam.gap.source import spec_key
+    from ehlfoam.paths import cache_dir
 
-    with file_lock(cache_root() / "precalc" / f".{spec_key(contact)}.lock", timeout=1e9):
+    with file_lock(cache_dir() / "precalc" / f".{spec_key(contact)}.lock", timeout=1e9):
         yield
 
 
 def precalc_cached(contact) -> bool:
     """True if the contact's EHL precalc is in this machine's cache."""
-    from ehlfoam.gap.source import cache_root, spec_key
+    from ehlfoam.gap.source import spec_key
+    from ehlfoam.paths import cache_dir
 
-    return (cache_root() / "precalc" / spec_key(contact) / "summary.json").is_file()
+    return (cache_dir() / "precalc" / spec_key(contact) / "summary.json").is_file()
 
 
 def ensure_precalc(batch_dir: Path, case_id: str) -> dict:

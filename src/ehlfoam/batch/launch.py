@@ -43,7 +43,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ehlfoam.contact.outputs import atomic_write_json, atomic_write_text
+from ehlfoam._io import atomic_write_json, atomic_write_text
 
 from ehlfoam.batch.case import oneline, precalc_cached
 from ehlfoam.batch.executors import DaskExecutor, LocalExecutor, cpu_budget, slurm_cluster

@@ -26,7 +26,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
-from ehlfoam.contact.outputs import atomic_write, atomic_write_json
+from ehlfoam._io import atomic_write, atomic_write_json
 
 STATES = ("I", "II")
 REGIME = "regime"

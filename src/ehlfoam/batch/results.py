@@ -9,7 +9,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from ehlfoam.contact.outputs import atomic_write_text
+from ehlfoam._io import atomic_write_text
 
 from ehlfoam.batch.folder import CASES, RESULTS, case_status, read_metrics
 from ehlfoam.batch.spec import PlannedCase

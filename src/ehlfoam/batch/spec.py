@@ -49,7 +49,9 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
 
-from ehlfoam.contact.spec import SpecError, read_toml
+from ehlfoam.errors import SpecError, format_validation_error
+
+from ehlfoam._io import read_toml
 from ehlfoam.spec.case import CaseSpec, make_case_spec
 
 __all__ = ["BatchSpec", "PlannedCase", "Ramp", "SpecError", "SupplyChoice", "Sweep",
@@ -312,51 +314,22 @@ class BatchSpec(BaseModel):
 
 
 # ------------------------------------------------------------------ errors
-def _format_errors(err: ValidationError, single_sweep: bool) -> str:
-    lines = []
-    for e in err.errors():
-        loc = list(e["loc"])
-        if single_sweep and len(loc) > 1 and loc[0] == "sweep" and loc[1] == 0:
-            loc.pop(1)
-        name = ""
-        for part in loc:
-            name += f"[{part}]" if isinstance(part, int) else (f".{part}" if name else str(part))
-        msg = e["msg"].removeprefix("Value error, ")
-        if e["type"] == "extra_forbidden":
-            model = _model_at(loc[:-1])
-            valid = ", ".join(model.model_fields) if model else ""
-            lines.append(f"{name}: unknown key (valid here: {valid})")
-        elif e["type"] == "missing":
-            hint = (": a ramp needs its speeds, e.g. speed_mm_s = [5, 8, 12, 17, 25]"
-                    if loc and loc[-1] == "speed_mm_s" else "")
-            lines.append(f"{name}: missing{hint}")
-        elif loc and "input" in e and not isinstance(e["input"], dict):
-            lines.append(f"{name} = {e['input']!r}: {msg}")
-        else:
-            lines.append(f"{name}: {msg}" if name else msg)
-    return "; ".join(lines)
+_HINTS = {"speed_mm_s": "a ramp needs its speeds, e.g. speed_mm_s = [5, 8, 12, 17, 25]"}
 
 
-def _model_at(loc: list) -> type[BaseModel] | None:
-    model: type[BaseModel] = BatchSpec
-    for part in loc:
-        if isinstance(part, int):
-            continue
-        sub = {("sweep",): Sweep, ("ramp",): Ramp}.get((part,))
-        if model is BatchSpec and sub is not None:
-            model = sub
-        else:
-            return None
-    return model
+def _single_sweep(loc: tuple) -> tuple:
+    """A single ``[sweep]`` table is held as a list of one: name it as the user wrote it."""
+    return loc[:1] + loc[2:] if loc[:2] == ("sweep", 0) else loc
 
 
 def parse_batch_spec(data: dict[str, Any], source: str = "batch spec") -> BatchSpec:
     """Validate batch spec data; :class:`SpecError` naming the key, value and valid range."""
-    single = isinstance(data.get("sweep"), dict)
+    rename = _single_sweep if isinstance(data.get("sweep"), dict) else None
     try:
         return BatchSpec(**data)
     except ValidationError as err:
-        raise SpecError(f"invalid {source}: {_format_errors(err, single)}") from None
+        text = format_validation_error(err, BatchSpec, hints=_HINTS, rename=rename)
+        raise SpecError(f"invalid {source}: {text}") from None
 
 
 def load_batch_spec(path: str | Path) -> BatchSpec:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ehlfoam.contact.outputs import atomic_write_text
+from ehlfoam._io import atomic_write_text
 
 #: OpenFOAM's list type for each number of components per value.
 _LIST_TYPES = {3: "vector", 6: "symmTensor", 9: "tensor"}

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from foamlib import FoamFieldFile, FoamFile
 
-from ehlfoam.contact.outputs import atomic_write_json, atomic_write_text
+from ehlfoam._io import atomic_write_json, atomic_write_text
 from ehlfoam.foam.runtime import FoamRuntime
 
 from ehlfoam.case import face_oil

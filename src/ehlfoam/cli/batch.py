@@ -76,7 +76,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def cmd_batch(args: argparse.Namespace) -> int:
     """Run (or dry-run) the batch; exit code as in the module doc."""
-    from ehlfoam.contact.spec import SpecError
+    from ehlfoam.errors import SpecError
 
     from ehlfoam.batch.launch import BatchError, BatchOptions, dry_run, run_batch
     from ehlfoam.batch.executors import parse_slurm

@@ -55,7 +55,7 @@ def cmd_doctor(args: argparse.Namespace) -> int:
 
 def cmd_case(args: argparse.Namespace) -> int:
     """Validate the spec, then build the case (precalc, mesh, OpenFOAM files)."""
-    from ehlfoam.contact.spec import SpecError
+    from ehlfoam.errors import SpecError
     from ehlfoam.spec.case import load_case_spec, make_case_spec
     from ehlfoam.case.writer import CaseExists, mesh_warnings
 

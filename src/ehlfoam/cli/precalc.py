@@ -10,7 +10,9 @@ import argparse
 import json
 import sys
 
-from ehlfoam.contact.spec import PrecalcSpec, SpecError, load_spec, make_spec, valid_range
+from ehlfoam.errors import SpecError
+
+from ehlfoam.contact.spec import PrecalcSpec, load_spec, make_spec, valid_range
 
 _OPTIONS = {
     # flag: (spec key, type, help with units)

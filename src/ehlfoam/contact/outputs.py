@@ -6,47 +6,12 @@ reader never sees a half-written file.
 
 from __future__ import annotations
 
-import json
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ehlfoam._io import atomic_write, atomic_write_json, finite_or_none
 from ehlfoam.contact.solver import PrecalcResult
-
-
-def atomic_write(path: Path, write) -> None:
-    """Write ``path`` through ``write(binary file)`` to a temporary sibling, then rename it."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            write(fh)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def finite_or_none(value):
-    """JSON has no NaN/inf: a blown-up run reports null."""
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: finite_or_none(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [finite_or_none(v) for v in value]
-    return value
-
-
-def atomic_write_text(path: Path, text: str) -> None:
-    """Write ``text`` (UTF-8) atomically."""
-    atomic_write(Path(path), lambda fh: fh.write(text.encode()))
-
-
-def atomic_write_json(path: Path, data) -> None:
-    """Write ``data`` as indented JSON atomically; NaN and inf become null."""
-    atomic_write_text(path, json.dumps(finite_or_none(data), indent=2, allow_nan=False) + "\n")
 
 
 def write_summary(result: PrecalcResult, out: Path) -> dict:

@@ -7,22 +7,19 @@ parameter, its value and the valid range (:class:`SpecError`).
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from ehlfoam._io import read_toml
+from ehlfoam.errors import SpecError, format_validation_error, range_text
 from ehlfoam.contact.formulas import Contact
 from ehlfoam.contact.lubricant import OIL_TABLES, Lubricant, PressureLaws, lubricant_from_table, table_range
 
 #: Ambient pressure [Pa] (reference, assumed).
 P_AMBIENT_PA = 1.013e5
 GRID_MIN, GRID_MAX = 65, 8193
-
-
-class SpecError(ValueError):
-    """An invalid input, with a message naming the parameter, its value and the valid range."""
 
 
 class PrecalcSpec(BaseModel):
@@ -124,36 +121,7 @@ def valid_range(name: str) -> str:
     field = PrecalcSpec.model_fields.get(name)
     if field is None:
         return ""
-    text = range_text(name, field)
-    return f"{text} {UNITS.get(name, '')}".rstrip() if text else ""
-
-
-def range_text(name: str, field) -> str:
-    """'valid range 0 < name <= 1' from a pydantic field's numeric constraints ('' if none)."""
-    lo = hi = ""
-    for m in getattr(field, "metadata", []):
-        for attr, fmt in (("gt", "{} < "), ("ge", "{} <= ")):
-            if getattr(m, attr, None) is not None:
-                lo = fmt.format(f"{getattr(m, attr):g}")
-        for attr, fmt in (("lt", " < {}"), ("le", " <= {}")):
-            if getattr(m, attr, None) is not None:
-                hi = fmt.format(f"{getattr(m, attr):g}")
-    return f"valid range {lo}{name}{hi}" if lo or hi else ""
-
-
-def _format_error(err: ValidationError) -> str:
-    lines = []
-    for e in err.errors():
-        loc = ".".join(str(p) for p in e["loc"]) or "spec"
-        msg = e["msg"].removeprefix("Value error, ")
-        if e["type"] == "extra_forbidden":
-            lines.append(f"{loc}: unknown parameter (valid: {', '.join(PrecalcSpec.model_fields)})")
-        elif "input" in e and e["loc"]:
-            rng = valid_range(loc)
-            lines.append(f"{loc} = {e['input']!r}: {msg}" + (f" ({rng})" if rng else ""))
-        else:
-            lines.append(msg)
-    return "; ".join(lines)
+    return range_text(name, field, UNITS.get(name, ""))
 
 
 def make_spec(**values) -> PrecalcSpec:
@@ -162,18 +130,8 @@ def make_spec(**values) -> PrecalcSpec:
     try:
         return PrecalcSpec(**values)
     except ValidationError as err:
-        raise SpecError(f"invalid input: {_format_error(err)}") from None
-
-
-def read_toml(path: str | Path) -> dict:
-    """A TOML file as a dict; :class:`SpecError` naming the file if missing or malformed."""
-    path = Path(path)
-    try:
-        return tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise SpecError(f"spec file = {str(path)!r}: no such file") from None
-    except tomllib.TOMLDecodeError as err:
-        raise SpecError(f"spec file = {str(path)!r}: not valid TOML ({err})") from None
+        raise SpecError("invalid input: "
+                        + format_validation_error(err, PrecalcSpec, units=UNITS)) from None
 
 
 def load_spec(path: str | Path, **overrides) -> PrecalcSpec:

@@ -43,6 +43,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+from ehlfoam.paths import cache_dir
+
 __all__ = [
     "GOOD_BUILD_MAX_ERROR",
     "BuildCheck",
@@ -51,7 +53,6 @@ __all__ = [
     "FoamRuntime",
     "FoamRuntimeMissing",
     "check_build",
-    "default_cache_dir",
     "parse_velocity_error",
 ]
 
@@ -102,15 +103,6 @@ class FoamConfigError(FoamError, ValueError):
     """The EHLFOAM_* configuration is invalid (bad input)."""
 
 
-def default_cache_dir(environ: Mapping[str, str] | None = None) -> Path:
-    """``$EHLFOAM_CACHE``, else ``${XDG_CACHE_HOME:-$HOME/.cache}/ehlfoam``."""
-    env = os.environ if environ is None else environ
-    if env.get("EHLFOAM_CACHE"):
-        return Path(env["EHLFOAM_CACHE"]).expanduser()
-    xdg = env.get("XDG_CACHE_HOME") or str(Path(env.get("HOME") or Path.home()) / ".cache")
-    return Path(xdg).expanduser() / "ehlfoam"
-
-
 @dataclass(frozen=True)
 class FoamRuntime:
     """A way to run OpenFOAM applications.
@@ -157,7 +149,7 @@ class FoamRuntime:
         env = os.environ if environ is None else environ
         kind = (env.get("EHLFOAM_FOAM") or "embedded").strip()
         if kind == "embedded":
-            return cls.embedded(default_cache_dir(env) / EMBEDDED_DIRNAME)
+            return cls.embedded(cache_dir(env) / EMBEDDED_DIRNAME)
         if kind == "native":
             return cls.native(env.get("WM_PROJECT_DIR") or None)
         if kind == "prefix":

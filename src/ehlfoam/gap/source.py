@@ -14,6 +14,7 @@ import tempfile
 from pathlib import Path
 
 from ehlfoam.gap.field import GapField
+from ehlfoam.paths import cache_dir
 from ehlfoam.contact.outputs import write_all
 from ehlfoam.contact.solver import solve
 from ehlfoam.contact.spec import PrecalcSpec
@@ -21,13 +22,6 @@ from ehlfoam.contact.spec import PrecalcSpec
 
 class PrecalcFailed(RuntimeError):
     """The EHL precalc of a case did not converge."""
-
-
-def cache_root() -> Path:
-    """``$EHLFOAM_CACHE`` or ``~/.cache/ehlfoam`` (as in ``tools/ensure-env``)."""
-    base = os.environ.get("EHLFOAM_CACHE") or Path(
-        os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "ehlfoam"
-    return Path(base)
 
 
 def spec_key(spec: PrecalcSpec) -> str:
@@ -40,7 +34,7 @@ def precalc_dir(spec: PrecalcSpec, cache: Path | None = None, require_converged:
 
     Raises :class:`PrecalcFailed` if the solution did not converge and ``require_converged``.
     """
-    root = (cache or cache_root()) / "precalc"
+    root = (cache or cache_dir()) / "precalc"
     final = root / spec_key(spec)
     if not (final / "summary.json").is_file():
         root.mkdir(parents=True, exist_ok=True)

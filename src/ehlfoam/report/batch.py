@@ -23,7 +23,7 @@ from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from pathlib import Path
 
-from ehlfoam.contact.outputs import atomic_write_json
+from ehlfoam._io import atomic_write_json
 
 from ehlfoam.metrics import convergence
 from ehlfoam.report import units

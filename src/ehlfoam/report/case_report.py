@@ -15,7 +15,7 @@ import time
 import traceback
 from pathlib import Path
 
-from ehlfoam.contact.outputs import atomic_write_json
+from ehlfoam._io import atomic_write_json
 
 from ehlfoam.report import units
 from ehlfoam.report.case_data import CaseInfo, load_case

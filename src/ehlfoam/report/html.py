@@ -12,7 +12,7 @@ from pathlib import Path
 
 import jinja2
 
-from ehlfoam.contact.outputs import atomic_write_text
+from ehlfoam._io import atomic_write_text
 
 
 @dataclass

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 from foamlib import FoamFile
 
-from ehlfoam.contact.outputs import atomic_write_json, atomic_write_text
+from ehlfoam._io import atomic_write_json, atomic_write_text
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.case.writer import (META, CaseGeometry, load_geometry, load_spec_of, mesh_warnings, size_function)
 

@@ -31,7 +31,7 @@ from typing import Any, Iterable
 import numpy as np
 from foamlib import FoamFieldFile
 
-from ehlfoam.contact.outputs import atomic_write
+from ehlfoam._io import atomic_write
 from ehlfoam.case.writer import META, load_geometry
 
 from ehlfoam.run.fields import Structure, time_folders, write_near

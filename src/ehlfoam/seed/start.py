@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from foamlib import FoamFieldFile
 
-from ehlfoam.contact.outputs import atomic_write_json
+from ehlfoam._io import atomic_write_json
 from ehlfoam.case.writer import META, load_geometry
 
 from ehlfoam.run.fields import Structure, time_folders

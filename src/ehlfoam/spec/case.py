@@ -41,14 +41,18 @@ from __future__ import annotations
 import math
 from functools import cached_property
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union, get_args
+from typing import Annotated, Any, Literal, Union
 
 import numpy as np
 from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError,
                       field_validator, model_validator)
 from scipy.spatial import cKDTree
 
-from ehlfoam.contact.spec import PrecalcSpec, SpecError, range_text, read_toml
+from ehlfoam.errors import SpecError, format_validation_error
+
+from ehlfoam._io import read_toml
+
+from ehlfoam.contact.spec import PrecalcSpec
 
 _STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
@@ -692,62 +696,6 @@ def _drop_none(value):
     return value
 
 
-# ------------------------------------------------------------------ errors
-def _models_in(annotation: Any) -> list[type[BaseModel]]:
-    """The model classes an annotation holds (itself, or inside a tuple, union, Annotated)."""
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return [annotation]
-    return [m for arg in get_args(annotation) for m in _models_in(arg)]
-
-
-def _spec_loc(loc: tuple) -> tuple:
-    """An error location as the spec names it: without the tag of a union member
-    (``mesh.refine.0.band.size`` -> ``mesh.refine.0.size``)."""
-    return tuple(p for i, p in enumerate(loc)
-                 if not (p in REFINE_KINDS and i > 0 and isinstance(loc[i - 1], int)))
-
-
-def _field_at(model: type[BaseModel], loc: tuple) -> tuple[type[BaseModel] | None, Any]:
-    """The model class and field info that a pydantic error location points at (through
-    tuples of models and tagged unions of them)."""
-    field = None
-    for part in loc:
-        if isinstance(part, int):
-            continue
-        if part in REFINE_KINDS and field is not None:
-            model, field = REFINE_KINDS[part], None
-            continue
-        if field is not None:
-            inner = _models_in(field.annotation)
-            if len(inner) != 1:
-                return model, None
-            model = inner[0]
-        field = model.model_fields.get(str(part))
-        if field is None:
-            return model, None
-    return model, field
-
-
-def format_errors(err: ValidationError, root: type[BaseModel] = None) -> str:
-    """One line per error: ``parameter = value: problem (valid range ...)``."""
-    root = root or CaseSpec
-    lines = []
-    for e in err.errors():
-        loc = tuple(e["loc"])
-        name = ".".join(str(p) for p in _spec_loc(loc)) or "spec"
-        msg = e["msg"].removeprefix("Value error, ")
-        model, field = _field_at(root, loc)
-        if e["type"] == "extra_forbidden":
-            valid = ", ".join(model.model_fields) if model else ""
-            lines.append(f"{name}: unknown parameter (valid here: {valid})")
-        elif loc and "input" in e and not isinstance(e["input"], dict):
-            rng = range_text(name, field) if field is not None else ""
-            lines.append(f"{name} = {e['input']!r}: {msg}" + (f" ({rng})" if rng else ""))
-        else:
-            lines.append(f"{name}: {msg}")
-    return "; ".join(lines)
-
-
 def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> CaseSpec:
     """Validate a case spec from nested data; ``overrides`` are dotted keys
     (``{"contact.speed": 0.017}``) applied on top; None clears an optional key
@@ -762,7 +710,7 @@ def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> Case
     try:
         spec = CaseSpec(**data)
     except ValidationError as err:
-        raise SpecError(f"invalid case spec: {format_errors(err)}") from None
+        raise SpecError(f"invalid case spec: {format_validation_error(err, CaseSpec)}") from None
     except SpecError as err:  # raised by PrecalcSpec's own validators
         raise SpecError(f"invalid case spec: contact: {err}") from None
     _check_supply_fits(spec)
