@@ -48,7 +48,7 @@ sys.path.insert(0, str(ROOT))
 from foamlib import FoamFieldFile  # noqa: E402
 
 from bench.common import apply_edits, edit_value_text, foam_edit, save, spec_option  # noqa: E402
-from ehlfoam.thinfilm.model import landau_levich
+from ehlfoam.thinfilm import landau_levich
 from ehlfoam.spec.case import CaseSpec, make_case_spec
 from ehlfoam.case.writer import (TEMPLATES, capillary_time_step, edit_physics_dicts, edit_run_control, extrude_level)
 from ehlfoam.gap.source import load_gap

@@ -32,7 +32,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save, spec_option  # noqa: E402
-from ehlfoam.thinfilm.model import ThinFilmProblem, solve_thin_film
+from ehlfoam.thinfilm import ThinFilmProblem, solve_thin_film
 from ehlfoam.thinfilm.state import load_state, save_state
 from ehlfoam.spec.case import CaseSpec, load_case_spec
 from ehlfoam.gap.source import load_gap

@@ -39,7 +39,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
 from bench.oil_change import columns  # noqa: E402
-from ehlfoam.thinfilm.model import landau_levich
+from ehlfoam.thinfilm import landau_levich
 from ehlfoam.case.writer import load_geometry, load_spec_of
 from ehlfoam.run import fields as case_fields
 

@@ -823,7 +823,7 @@ def _thin_film_state(path: Path, a: float, films: float, gap_factor: float = 1.0
     """A thin-film state written by hand on 0.25 a cells over x = -2..4 a, y = 0..2 a of the
     small case's gap (times ``gap_factor``): flooded ahead of x = a, films of ``films`` of the
     gap behind."""
-    from ehlfoam.thinfilm.model import Grid, ThinFilmSolution
+    from ehlfoam.thinfilm import Grid, ThinFilmSolution
     from ehlfoam.thinfilm.state import save_state
     from ehlfoam.gap.source import load_gap
 

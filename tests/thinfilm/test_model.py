@@ -1,4 +1,4 @@
-"""The thin-film model of the flooded region (ehlfoam.thinfilm.model): a strip against
+"""The thin-film model of the flooded region (ehlfoam.thinfilm): a strip against
 its 1D theory, a region round an island, films, metrics and bad input."""
 
 from __future__ import annotations
@@ -8,7 +8,8 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from ehlfoam.thinfilm.model import (Grid, ThinFilmProblem, ThinFilmSolution, landau_levich, region_metrics, solve_thin_film)
+from ehlfoam.thinfilm import (Grid, ThinFilmProblem, ThinFilmSolution, landau_levich,
+                              region_metrics, solve_thin_film)
 
 ETA, U, SIGMA, THETA = 0.02, 0.01, 0.03, 15.0
 
@@ -120,18 +121,18 @@ def test_thicker_films_hold_less_oil_in_a_narrower_region():
 def test_the_receding_pull_acts_where_the_walls_leave_the_meniscus(receding, pull):
     """On a round region the open cells get the full pull straight behind it, none ahead
     of it or beside it, and n^(2/3) of it in between."""
-    from ehlfoam.thinfilm.model import _Operators, _touches
+    from ehlfoam.thinfilm.operators import Operators, touches
 
     prob = ball_problem(receding_meniscus=receding, cell=0.2 * A)
     grid = Grid.build(prob)
-    ops = _Operators(prob, grid)
+    ops = Operators(prob, grid)
     X, Y = np.meshgrid(grid.x, grid.y)
     flooded = (np.hypot(X, Y) < 6 * A) & ~grid.island
     factor = ops.pull_factor(flooded)
     if pull is None:
         cos_t = np.cos(np.radians(THETA))
         pull = (1 + 3.8 * (0.0216 * 0.008 / SIGMA) ** (2 / 3)) / cos_t
-    edge = _touches(flooded) & ~grid.island
+    edge = touches(flooded) & ~grid.island
     rear = edge[0] & (grid.x > 0)
     front = edge[0] & (grid.x < 0)
     assert factor[0, rear] == pytest.approx(pull, rel=1e-3)
@@ -142,7 +143,7 @@ def test_the_receding_pull_acts_where_the_walls_leave_the_meniscus(receding, pul
     assert factor[at45] == pytest.approx(1 + (pull - 1) * np.cos(np.pi / 4) ** (2 / 3),
                                          rel=0.02)
     assert (factor[~edge & ~flooded & ~grid.island] >= 1.0).all()
-    static = _Operators(ball_problem(receding_meniscus=1.0), grid)
+    static = Operators(ball_problem(receding_meniscus=1.0), grid)
     assert np.all(static.pull_factor(flooded) == 1.0)
 
 
@@ -151,15 +152,15 @@ def test_the_advancing_angle_acts_where_dry_walls_run_into_the_meniscus():
     take cos(theta_a) / cos(theta_s) of the static suction, beside it none of the change,
     and in between Cox-Voinov's theta^3 at the share of the walls' speed into it; on the
     track, where the supply's layers meet it, the static suction stays."""
-    from ehlfoam.thinfilm.model import _Operators, _touches
+    from ehlfoam.thinfilm.operators import Operators, touches
 
     prob = ball_problem(advancing_angle=47.0, cell=0.2 * A, track_half_width=2 * A)
     grid = Grid.build(prob)
-    ops = _Operators(prob, grid)
+    ops = Operators(prob, grid)
     X, Y = np.meshgrid(grid.x, grid.y)
     flooded = (np.hypot(X, Y) < 6 * A) & ~grid.island
     factor = ops.pull_factor(flooded)
-    edge = _touches(flooded) & ~grid.island
+    edge = touches(flooded) & ~grid.island
     ts, ta = np.radians(THETA), np.radians(47.0)
     assert factor[0, edge[0] & (grid.x < 0)] == pytest.approx(1.0)       # on the track
     assert factor[0, edge[0] & (grid.x > 0)] == pytest.approx(1.0)       # the rear
@@ -171,7 +172,7 @@ def test_the_advancing_angle_acts_where_dry_walls_run_into_the_meniscus():
     expected = np.cos(np.cbrt(ts**3 + m * (ta**3 - ts**3))) / np.cos(ts)
     assert factor[at135] == pytest.approx(expected, rel=0.03)
     assert expected < 0.85                    # a weaker suction than the static one
-    static = _Operators(ball_problem(cell=0.2 * A), grid)
+    static = Operators(ball_problem(cell=0.2 * A), grid)
     assert np.all(static.pull_factor(flooded) == 1.0)
 
 
@@ -181,13 +182,13 @@ def test_a_normal_length_in_metres_gives_every_grid_the_same_pull():
     cells against the mean of the fine cells in them): 90 % of them within 2.5 % of the
     pull's excess at 0.6 a; at 1.5 cells each (the default) the two grids' staircases give
     different normals, twice that apart."""
-    from ehlfoam.thinfilm.model import _Operators, _touches
+    from ehlfoam.thinfilm.operators import Operators, touches
 
     def pull_field(cell, normal_length):
         prob = ball_problem(receding_meniscus="bretherton", cell=cell * A,
                             normal_length=normal_length)
         grid = Grid.build(prob)
-        ops = _Operators(prob, grid)
+        ops = Operators(prob, grid)
         X, Y = np.meshgrid(grid.x, grid.y)
         xr, yr = (X - Y) / np.sqrt(2), (X + Y) / np.sqrt(2)
         flooded = ((xr / (7 * A)) ** 2 + (yr / (4 * A)) ** 2 < 1) & ~grid.island
@@ -199,7 +200,7 @@ def test_a_normal_length_in_metres_gives_every_grid_the_same_pull():
         fine, fl_f, _ = pull_field(0.1, normal_length)
         fine_mean = 0.25 * (fine[0::2, 0::2] + fine[1::2, 0::2] + fine[0::2, 1::2]
                             + fine[1::2, 1::2])
-        edge = _touches(fl_c) & ~grid_c.island & (fl_c == fl_f[0::2, 0::2])
+        edge = touches(fl_c) & ~grid_c.island & (fl_c == fl_f[0::2, 0::2])
         excess = coarse[~grid_c.island].max() - 1.0
         apart[normal_length] = np.percentile(np.abs(coarse - fine_mean)[edge] / excess, 90)
     assert apart[0.6 * A] < 0.025

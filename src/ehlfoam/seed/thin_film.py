@@ -1,6 +1,6 @@
 """Start a 3D case from a thin-film state: the flooded region the gap-averaged model balanced.
 
-The thin-film model (``ehlfoam.thinfilm.model``) brings the nominal region to its
+The thin-film model (:mod:`ehlfoam.thinfilm`) brings the nominal region to its
 balance in minutes on one core; a 3D case from the spec's puddle takes hours to get there on
 two. A state the model wrote (``bench/thin_film_region.py``, :mod:`ehlfoam.thinfilm.state`)
 gives the 3D case its oil instead: each column of cells is oil where the model's cell is
@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from foamlib import FoamFieldFile
 
-from ehlfoam.thinfilm.model import ThinFilmSolution
+from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state
 from ehlfoam.case.writer import wall_layers_fraction
 

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ehlfoam.thinfilm.model import Grid, ThinFilmSolution
+from ehlfoam.thinfilm.problem import Grid
+from ehlfoam.thinfilm.solution import ThinFilmSolution
 
 
 def save_state(sol: ThinFilmSolution, path: str | Path) -> None:
