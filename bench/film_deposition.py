@@ -52,8 +52,9 @@ from ehlfoam.thinfilm import landau_levich
 from ehlfoam.spec.case import CaseSpec, make_case_spec
 from ehlfoam.case.writer import (TEMPLATES, capillary_time_step, edit_physics_dicts, edit_run_control, extrude_level)
 from ehlfoam.gap.source import load_gap
-from ehlfoam.mesh import mesh as mesh_module
-from ehlfoam.mesh.mesh import BaseMesh, PolyMesh, split_patch, write_polymesh
+from ehlfoam.mesh.gmsh_model import extract_mesh, gmsh_model
+from ehlfoam.mesh.topology import edge_topology
+from ehlfoam.mesh import BaseMesh, PolyMesh, split_patch, write_polymesh
 from ehlfoam.run import fields as case_fields
 from ehlfoam.foam.runtime import FoamRuntime
 
@@ -123,7 +124,7 @@ def slab_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float,
     if not free and dx < 0.5 * s_in:
         raise ValueError(f"dx = {dx:.3g} m: aligned slab cells must be at least the columns' "
                          f"lean at x_in = {x_in:.3g} m, {0.5 * s_in:.3g} m")
-    with mesh_module._gmsh_model("film-slab"):
+    with gmsh_model("film-slab"):
         surface = gmsh.model.occ.addRectangle(x_in, 0.0, 0.0, x_out - x_in, width)
         gmsh.model.occ.synchronize()
         if not free:
@@ -136,10 +137,10 @@ def slab_mesh(spec: CaseSpec, gap, x_in: float, x_out: float, dx: float,
         gmsh.model.mesh.setSizeCallback(
             lambda dim, tag, x, y, z, lc: cell_size(x, x_in, dx, s_in))
         gmsh.model.mesh.generate(2)
-        points, quads, _ = mesh_module._extract_mesh({})   # raises on any non-quad
+        points, quads, _ = extract_mesh({})   # raises on any non-quad
     base = BaseMesh(points, quads)
     quads = np.where((base.quad_areas() < 0)[:, None], quads[:, ::-1], quads)
-    topo = mesh_module._edge_topology(quads, len(points))   # boundary edges, quad on the left
+    topo = edge_topology(quads, len(points))   # boundary edges, quad on the left
     outer = np.stack([topo.bnd_a, topo.bnd_b], axis=1)
     mid = points[outer].mean(axis=1)
     tol = 1e-6 * dx

@@ -183,7 +183,7 @@ def test_meshed_gap_matches_the_gap_export(level, ring):
     without the polar ring."""
     from ehlfoam.case.writer import size_function
     from ehlfoam.gap.source import load_gap
-    from ehlfoam.mesh.mesh import MeshParams, build_base_mesh, extrude, gap_mismatch
+    from ehlfoam.mesh import MeshParams, build_base_mesh, extrude, gap_mismatch
 
     spec = make_case_spec({**SMALL, "mesh": {"resolution": level}})
     gap, _ = load_gap(spec.contact)
@@ -201,7 +201,7 @@ def test_a_refinement_box_refines_the_free_quads_inside_it():
     growing back at REFINE_GROWTH in between; a box that is not a box is refused naming it."""
     from ehlfoam.spec.case import REFINE_GROWTH
     from ehlfoam.case.writer import size_function
-    from ehlfoam.mesh.mesh import MeshParams, build_base_mesh
+    from ehlfoam.mesh import MeshParams, build_base_mesh
 
     def base(spec):
         a, d = spec.a, spec.domain
@@ -260,7 +260,7 @@ def test_a_band_refines_the_free_quads_along_its_line():
     is refused, naming it."""
     from ehlfoam.spec.case import REFINE_GROWTH
     from ehlfoam.case.writer import size_function
-    from ehlfoam.mesh.mesh import MeshParams, build_base_mesh
+    from ehlfoam.mesh import MeshParams, build_base_mesh
 
     # a quarter circle of r = 3 a from the upstream axis round to x = 0 (points every 0.3 a)
     phi = np.linspace(np.pi, np.pi / 2, 17)

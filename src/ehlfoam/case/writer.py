@@ -28,7 +28,8 @@ from ehlfoam.case import face_oil
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.case.foam_lists import fill_placeholders, placeholder
 from ehlfoam.gap.source import load_gap
-from ehlfoam.mesh.mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch, split_patch, wall_steps, write_polymesh)
+from ehlfoam.mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
+                          split_patch, wall_steps, write_polymesh)
 from ehlfoam.case.wall_slip import navier_slip, rolling_velocity, wall_normals, write_slip_walls
 
 TEMPLATES = Path(__file__).resolve().parent / "templates"
@@ -83,7 +84,7 @@ class CaseGeometry:
     release_pressure_gauge: float = 0.0
     air_solubility: float = 0.09
     #: median over the base cells of the wall-cell heights the ball surface steps across a
-    #: cell (ehlfoam.mesh.mesh.wall_steps); above BALL_WALL_STEPS_LIMIT a spurious film creeps
+    #: cell (ehlfoam.mesh.wall_steps); above BALL_WALL_STEPS_LIMIT a spurious film creeps
     #: along the ball (0: not computed, a case written before it existed)
     ball_wall_steps: float = 0.0
     #: the oil fraction of what flows in through the boundaries open to the outside: 0 (air)
@@ -477,7 +478,7 @@ def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int, solver: str) 
     (case / "Allrun").write_text(text)
 
 
-#: the median ball wall steps (ehlfoam.mesh.mesh.wall_steps) above which a case is flagged: the
+#: the median ball wall steps (ehlfoam.mesh.wall_steps) above which a case is flagged: the
 #: three levels give 7-9; at 15-90 (thinner wall cells under the same in-plane cells) a
 #: spurious oil film creeps along the ball beside the flooded region and 10-54 % of the
 #: outflow leaves through the side (docs/cases.md, "Thinner wall cells: the ball's stair-steps")
