@@ -28,7 +28,8 @@ sys.path.insert(0, str(ROOT))
 from bench.common import RESULTS  # noqa: E402
 from bench.fill_extrapolation import analyse  # noqa: E402
 from bench.film_deposition import FILM  # noqa: E402
-from ehlfoam.spec.case import CaseSpec, Mesh
+from ehlfoam.spec.case import CaseSpec
+from ehlfoam.spec.mesh import Mesh
 from ehlfoam.case.writer import load_spec_of
 from ehlfoam.run.monitor import rear_meniscus_cell
 

@@ -22,7 +22,9 @@ from foamlib import FoamFieldFile, FoamFile
 
 from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_time_step, load_geometry, load_spec_of, mesh_warnings, write_case)
+from ehlfoam.case.writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_time_step,
+                                 load_geometry, load_spec_of, mesh_warnings, write_case)
+from ehlfoam.mesh import refinement_size
 from ehlfoam.run import fields as case_fields
 from ehlfoam.cli.main import parse_value
 from ehlfoam.foam.runtime import FoamRuntime
@@ -181,9 +183,8 @@ def test_time_step_options_reach_the_dictionaries(tmp_path):
 def test_meshed_gap_matches_the_gap_export(level, ring):
     """At the resolution levels the meshed gap is the precalc's gap within 1 %, with or
     without the polar ring."""
-    from ehlfoam.case.writer import size_function
     from ehlfoam.gap.source import load_gap
-    from ehlfoam.mesh import MeshParams, build_base_mesh, extrude, gap_mismatch
+    from ehlfoam.mesh import MeshParams, build_base_mesh, extrude, gap_mismatch, size_function
 
     spec = make_case_spec({**SMALL, "mesh": {"resolution": level}})
     gap, _ = load_gap(spec.contact)
@@ -199,9 +200,7 @@ def test_meshed_gap_matches_the_gap_export(level, ring):
 def test_a_refinement_box_refines_the_free_quads_inside_it():
     """mesh.refine: quads of about the box's size inside it, the level's outside, the cells
     growing back at REFINE_GROWTH in between; a box that is not a box is refused naming it."""
-    from ehlfoam.spec.case import REFINE_GROWTH
-    from ehlfoam.case.writer import size_function
-    from ehlfoam.mesh import MeshParams, build_base_mesh
+    from ehlfoam.mesh import REFINE_GROWTH, MeshParams, build_base_mesh, size_function
 
     def base(spec):
         a, d = spec.a, spec.domain
@@ -235,7 +234,7 @@ def test_the_capillary_step_is_set_for_the_finest_refinement(tmp_path):
     """A refinement finer than the level's rim sets the case's capillary step (until
     2026-11-27 the rim alone did, and a fine band ran at 1.6 times its own limit); a coarser
     one leaves the rim's."""
-    from ehlfoam.case.writer import smallest_cell_size
+    from ehlfoam.mesh import smallest_cell_size
 
     box = {"x_min": 4.0, "x_max": 6.5, "y_min": 0.0, "y_max": 4.5, "size": 0.1}
     plain = make_case_spec(SMALL)
@@ -258,9 +257,7 @@ def test_a_band_refines_the_free_quads_along_its_line():
     """mesh.refine with points: quads of the band's size within half_width of its line, the
     level's far from it; the line is read as (x, |y|); a band with one point or below y = 0
     is refused, naming it."""
-    from ehlfoam.spec.case import REFINE_GROWTH
-    from ehlfoam.case.writer import size_function
-    from ehlfoam.mesh import MeshParams, build_base_mesh
+    from ehlfoam.mesh import REFINE_GROWTH, MeshParams, build_base_mesh, size_function
 
     # a quarter circle of r = 3 a from the upstream axis round to x = 0 (points every 0.3 a)
     phi = np.linspace(np.pi, np.pi / 2, 17)
@@ -317,7 +314,8 @@ def test_ehlfoam_band_follows_a_written_meniscus(small_case, tmp_path):
     assert np.hypot(*np.diff(pts, axis=0).T).max() < 0.5 / 4 + 1e-6   # every half_width / 4
     assert sorted([pts[0, 0], pts[-1, 0]]) == pytest.approx([-2.5, 2.5], abs=cell)
     spec = make_case_spec({**SMALL, "mesh": {**SMALL["mesh"], "refine": refine}})
-    assert spec.mesh.refine[0].size_at(np.array([0.0]), np.array([2.5])) == pytest.approx(0.1)
+    size = refinement_size(spec.mesh.refine[0])
+    assert size(np.array([0.0]), np.array([2.5])) == pytest.approx(0.1)
     bad = subprocess.run(EHLFOAM + ["band", str(case), "--size", "0.1", "--half-width", "-1"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "--half-width = -1 a is out of range" in bad.stderr

@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 
 from ehlfoam.errors import SpecError
-from ehlfoam.spec.case import (FOLLOW_BASE, FOLLOW_LEVELS, FOLLOW_POLAR_RADIUS, RefineBand, SideBox, make_case_spec)
+from ehlfoam.spec.case import make_case_spec
+from ehlfoam.spec.levels import FOLLOW_BASE, FOLLOW_LEVELS, FOLLOW_POLAR_RADIUS
+from ehlfoam.spec.mesh import RefineBand, SideBox
 from ehlfoam.case.writer import load_geometry, write_case
 from ehlfoam.seed.band import side_bands
 from tests.case.test_writer import EHLFOAM, _thin_film_state, _toml

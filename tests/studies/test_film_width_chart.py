@@ -7,7 +7,8 @@ from __future__ import annotations
 import pytest
 
 from bench.film_width_chart import _series, rear_cell_size, strip_table
-from ehlfoam.spec.case import RESOLUTIONS, make_case_spec
+from ehlfoam.spec.case import make_case_spec
+from ehlfoam.spec.levels import RESOLUTIONS
 
 
 def test_a_strip_row_is_filed_by_its_wall_layers_and_schemes():

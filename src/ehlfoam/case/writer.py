@@ -29,7 +29,8 @@ from ehlfoam.spec.case import CaseSpec
 from ehlfoam.case.foam_lists import fill_placeholders, placeholder
 from ehlfoam.gap.source import load_gap
 from ehlfoam.mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
-                          split_patch, wall_steps, write_polymesh)
+                          size_function, smallest_cell_size, split_patch, wall_steps,
+                          write_polymesh)
 from ehlfoam.case.wall_slip import navier_slip, rolling_velocity, wall_normals, write_slip_walls
 
 TEMPLATES = Path(__file__).resolve().parent / "templates"
@@ -108,34 +109,6 @@ class CaseGeometry:
 
 
 # --------------------------------------------------------------- numbers
-def size_function(spec: CaseSpec):
-    """In-plane cell size [m] at (x, y): size_rim at the island rim, growing in proportion to
-    the distance from the contact centre (the gap grows like r^2, the meniscus sits a few a
-    out), capped at size_far; smaller where a refinement box (mesh.refine) asks for it."""
-    level, a, ri = spec.mesh.level(), spec.a, spec.domain.island_radius * spec.a
-    rim, far = level["size_rim"] * a, level["size_far"] * a
-    boxes = spec.mesh.refine
-
-    def size(x, y):
-        x, y = np.asarray(x, float), np.asarray(y, float)
-        out = np.clip(rim * np.hypot(x, y) / ri, rim, far)
-        for box in boxes:
-            out = np.minimum(out, box.size_at(x / a, y / a) * a)
-        return out
-
-    return size
-
-
-def smallest_cell_size(spec: CaseSpec) -> float:
-    """The smallest in-plane cell [m] :func:`size_function` asks for: the level's size at the
-    island rim, or a refinement's (mesh.refine) where it is finer. The capillary time step is
-    set for it: before 2026-11-27 it was set for the rim alone, so a band of 0.035 a cells on
-    the fine level (rim 0.055 a) ran at a step 1.6 times its own limit, and the 2D strip shows
-    films that double at such steps (docs/cases.md, "The films' own time step")."""
-    sizes = [spec.mesh.level()["size_rim"]] + [box.size for box in spec.mesh.refine]
-    return min(sizes) * spec.a
-
-
 def capillary_time_step(spec: CaseSpec, dx: float) -> float:
     """Surface-tension time-step limit [s] for in-plane cells of size dx [m].
 

@@ -5,7 +5,7 @@ cells where dry walls run into it, and lays its films right only in cells of 0.0
 rear (docs/cases.md, "The region's sides are moving contact lines", "The films decide the
 width"). Hand-placed boxes (``mesh.refine``) covered it piece by piece; this module reads the
 meniscus itself off a written time, the ``alpha = 0.5`` lines of the mid-gap oil fraction, and
-turns each line into a :class:`~ehlfoam.spec.case.RefineBand` of a chosen size and half-width
+turns each line into a :class:`~ehlfoam.spec.mesh.RefineBand` of a chosen size and half-width
 in the half domain y >= 0. A run continued from that write (``--start-from``) on a mesh with the
 bands then has its whole meniscus in the band's cells, as long as the meniscus stays within the
 band.
@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ehlfoam.spec.case import RefineBand, SideBox
+from ehlfoam.spec.mesh import RefineBand, SideBox
 from ehlfoam.case.writer import load_geometry
 
 from ehlfoam.run import fields as case_fields
@@ -97,7 +97,7 @@ def meniscus_bands(lines: list[np.ndarray], size: float, half_width: float,
 def side_bands(bands: list[RefineBand], sides: SideBox) -> list[RefineBand]:
     """A band of half the size and half the half-width (or the sizes ``sides`` gives) along
     each run of consecutive points of ``bands`` that lies in ``sides`` (the region's sides,
-    where the meniscus sets the width; :class:`~ehlfoam.spec.case.SideBox`). Runs of a
+    where the meniscus sets the width; :class:`~ehlfoam.spec.mesh.SideBox`). Runs of a
     single point are left out."""
     out = []
     for band in bands:

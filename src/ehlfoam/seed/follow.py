@@ -1,9 +1,9 @@
 """Cases whose mesh follows the meniscus of the state they start from (``mesh.follow``).
 
-The levels of :data:`~ehlfoam.spec.case.RESOLUTIONS` leave the meniscus in their base cells,
+The levels of :data:`~ehlfoam.spec.levels.RESOLUTIONS` leave the meniscus in their base cells,
 and the flooded width does not converge over them; with bands of cells along the whole
 meniscus, twice as fine on the region's sides, and one thin wall cell everywhere
-(:data:`~ehlfoam.spec.case.FOLLOW_LEVELS`, whose comment gives what they converge), the
+(:data:`~ehlfoam.spec.levels.FOLLOW_LEVELS`), the
 meniscus is resolved on every level (docs/cases.md, "Resolved levels"). A case of such a
 level is written in three steps:
 
