@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from ehlfoam.spec.case import SOLVERS
-from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.case.geometry import load_geometry, load_spec_of
 from ehlfoam.run import fields as cf
 from ehlfoam.foam.runtime import FoamRuntime
 

@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.case.geometry import load_geometry
 from common import apply_edits, foam_edit, solver_cpu_s, spec_option  # noqa: E402
 from ehlfoam.seed.follow import write_started_case
 from ehlfoam.run.monitor import run_case

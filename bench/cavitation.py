@@ -29,7 +29,8 @@ from common import solver_cpu_s  # noqa: E402
 
 from ehlfoam._io import atomic_write_json
 from ehlfoam.spec.case import load_case_spec
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from ehlfoam.run import fields as case_fields
 from ehlfoam.seed.start import seed_from_previous
 from ehlfoam.run.monitor import mass_balance, run_case

@@ -33,7 +33,8 @@ from foamlib import FoamFile  # noqa: E402
 
 from ehlfoam._io import atomic_write_json
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import META, write_case
+from ehlfoam.case.geometry import META
+from ehlfoam.case.writer import write_case
 from ehlfoam.run.monitor import run_case
 
 RESULTS = ROOT / "bench" / "results"

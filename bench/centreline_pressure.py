@@ -27,7 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from foamlib import FoamFieldFile  # noqa: E402
 
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.case.geometry import load_geometry
 from ehlfoam.run import fields as case_fields
 
 #: spacing of the samples along the centre line [a]

@@ -126,7 +126,7 @@ def apply_edits(case: Path, edits: list, solver: str = "") -> None:
     from foamlib import FoamFile
 
     from ehlfoam._io import atomic_write_json
-    from ehlfoam.case.writer import META, load_geometry
+    from ehlfoam.case.geometry import META, load_geometry
 
     for file, keys, value in edits:
         with FoamFile(case / file if "/" in file else case / "system" / file) as f:

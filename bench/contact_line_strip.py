@@ -54,7 +54,7 @@ from foamlib import FoamFieldFile  # noqa: E402
 from bench.film_deposition import (add_strip_options, measure, options_suffix,  # noqa: E402
                                    run_or_reuse, save_rows, strip_mesh, sweep)
 from ehlfoam.spec.case import CaseSpec
-from ehlfoam.case.writer import slip_walls, wall_layers_fraction
+from ehlfoam.case.fields import slip_walls, wall_layers_fraction
 from ehlfoam.mesh import PolyMesh
 from ehlfoam.case.wall_slip import write_slip_walls
 from ehlfoam.run import fields as case_fields

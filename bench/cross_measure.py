@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import log, save  # noqa: E402
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.case.geometry import load_geometry
 from ehlfoam.metrics import pattern as metrics
 from ehlfoam.run.fields import Structure, mid_gap_raster
 from ehlfoam.seed.snapshot import map_snapshot

@@ -50,7 +50,9 @@ from foamlib import FoamFieldFile  # noqa: E402
 from bench.common import apply_edits, edit_value_text, foam_edit, save, spec_option  # noqa: E402
 from ehlfoam.thinfilm import landau_levich
 from ehlfoam.spec.case import CaseSpec, make_case_spec
-from ehlfoam.case.writer import (TEMPLATES, capillary_time_step, edit_physics_dicts, edit_run_control, extrude_level)
+from ehlfoam.case.dictionaries import edit_physics_dicts, edit_run_control
+from ehlfoam.case.timestep import capillary_time_step
+from ehlfoam.case.writer import TEMPLATES, extrude_level
 from ehlfoam.gap.source import load_gap
 from ehlfoam.mesh.gmsh_model import extract_mesh, gmsh_model
 from ehlfoam.mesh.topology import edge_topology

@@ -30,7 +30,7 @@ from bench.fill_extrapolation import analyse  # noqa: E402
 from bench.film_deposition import FILM  # noqa: E402
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.mesh import Mesh
-from ehlfoam.case.writer import load_spec_of
+from ehlfoam.case.geometry import load_spec_of
 from ehlfoam.run.monitor import rear_meniscus_cell
 
 

@@ -26,7 +26,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.case.geometry import load_geometry
 from ehlfoam.run import fields as case_fields
 
 

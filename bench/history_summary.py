@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import RESULTS, save  # noqa: E402
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.case.geometry import load_geometry
 from ehlfoam.run import fields as case_fields
 from ehlfoam.run.fields import off_outlet_share
 from ehlfoam.report.case_data import read_history

@@ -40,7 +40,7 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import RESULTS, save  # noqa: E402
 from ehlfoam.gap.field import GapField
-from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.case.geometry import load_geometry, load_spec_of
 from ehlfoam.run.fields import Structure, mid_gap_alpha, time_folders
 
 

@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.case.geometry import load_geometry
 from ehlfoam.metrics.convergence import (METRICS, history_number, jitter, last_transit, observed_order, read_history_rows, window_mean)
 
 KEYS = METRICS

@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from bench.plot_midgap import dress_top_view, parse_window  # noqa: E402
-from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.case.geometry import load_geometry, load_spec_of
 from ehlfoam.run import fields as case_fields
 
 NL = 1e-12  # m3 per nanolitre

@@ -35,7 +35,7 @@ from bench.common import save  # noqa: E402
 from ehlfoam.thinfilm.state import load_state
 from bench.wall_films import rear_meniscus  # noqa: E402
 from ehlfoam.spec.case import CaseSpec, load_case_spec
-from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.case.geometry import load_geometry, load_spec_of
 from ehlfoam.run import fields as case_fields
 
 #: the oil and air fractions that bound the interface cells

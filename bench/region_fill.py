@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from bench.oil_change import columns  # noqa: E402
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.case.geometry import load_geometry
 from ehlfoam.run import fields as case_fields
 from ehlfoam.metrics.convergence import history_number, read_history_rows
 

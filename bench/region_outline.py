@@ -25,7 +25,7 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from bench.plot_midgap import _pick  # noqa: E402
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.case.geometry import load_geometry
 from ehlfoam.run import fields as case_fields
 from ehlfoam.metrics import pattern as metrics
 

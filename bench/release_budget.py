@@ -23,7 +23,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bench.common import save  # noqa: E402
-from ehlfoam.case.writer import load_geometry, load_spec_of, release_geometry
+from ehlfoam.case.dictionaries import release_geometry
+from ehlfoam.case.geometry import load_geometry, load_spec_of
 from ehlfoam.run import fields as case_fields
 from ehlfoam.run.monitor import dissolved_air_budget
 

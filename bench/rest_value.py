@@ -28,7 +28,7 @@ sys.path.insert(0, str(ROOT))
 
 from bench.common import save  # noqa: E402
 from bench.plot_midgap import _pick  # noqa: E402
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.case.geometry import load_geometry
 from ehlfoam.seed.snapshot import is_snapshot, snapshot_history
 from ehlfoam.metrics.convergence import METRICS, rest_value
 from ehlfoam.report.case_data import read_history

@@ -27,7 +27,8 @@ from foamlib import FoamFieldFile  # noqa: E402
 
 from ehlfoam.thinfilm.rigid import solve_rigid_reynolds
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from ehlfoam.gap.source import load_gap
 from common import spec_option  # noqa: E402
 from ehlfoam.run import fields as case_fields

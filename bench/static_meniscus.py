@@ -35,7 +35,8 @@ sys.path.insert(0, str(ROOT))
 from foamlib import FoamFieldFile  # noqa: E402
 
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from common import apply_edits, edit_value_text, foam_edit, spec_option  # noqa: E402
 from ehlfoam.run import fields as case_fields
 from ehlfoam.run.monitor import run_case

@@ -40,7 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from bench.common import save  # noqa: E402
 from bench.oil_change import columns  # noqa: E402
 from ehlfoam.thinfilm import landau_levich
-from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.case.geometry import load_geometry, load_spec_of
 from ehlfoam.run import fields as case_fields
 
 #: where the films are read, in units of a: (name, x > ..., |y| < ..., |y| > ...)

@@ -3,7 +3,7 @@ precalc (the gap outside the island hardly depends on the film's last digits), 1
 from a puddle of 3 a around the contact. Builds in seconds, runs in seconds. And the numbers
 of a made-up case (:func:`tiny_geometry`) for code that only reads a case's geometry."""
 
-from ehlfoam.case.writer import CaseGeometry
+from ehlfoam.case.geometry import CaseGeometry
 
 SMALL = {
     "name": "test",

@@ -23,7 +23,8 @@ import pytest
 from foamlib import FoamFieldFile
 
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from ehlfoam.cli import batch as batch_cli
 from ehlfoam.run import fields as case_fields
 from ehlfoam.batch.launch import BatchError, BatchOptions, run_batch

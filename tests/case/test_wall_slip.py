@@ -1,4 +1,4 @@
-"""Navier slip on the walls (generator/wall_slip.py): the directionMixed entry's algebra, its
+"""Navier slip on the walls (ehlfoam.case.wall_slip): the directionMixed entry's algebra, its
 writing, and that v1912's solver holds the wall's fluid at u_s - U_w = lambda du/dn."""
 
 from __future__ import annotations
@@ -10,7 +10,8 @@ import pytest
 from foamlib import FoamFieldFile
 
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import case_mesh, load_spec_of, write_case
+from ehlfoam.case.geometry import load_spec_of
+from ehlfoam.case.writer import case_mesh, write_case
 from ehlfoam.gap.source import load_gap
 from ehlfoam.case.wall_slip import navier_slip, slip_fraction, wall_normals
 from ehlfoam.run import fields as case_fields

@@ -22,8 +22,9 @@ from foamlib import FoamFieldFile, FoamFile
 
 from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_time_step,
-                                 load_geometry, load_spec_of, mesh_warnings, write_case)
+from ehlfoam.case.geometry import BALL_WALL_STEPS_LIMIT, load_geometry, load_spec_of, mesh_warnings
+from ehlfoam.case.timestep import capillary_time_step
+from ehlfoam.case.writer import CaseExists, write_case
 from ehlfoam.mesh import refinement_size
 from ehlfoam.run import fields as case_fields
 from ehlfoam.cli.main import parse_value
@@ -600,7 +601,7 @@ def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
     # times here): the release has no budget, and the run says so (docs/cavitation.md)
     assert 0.0 < m["gas_released_m3"] < m["dissolved_air_m3"]   # the puddle's air, in 1 ms
     assert m["gas_release_over_dissolved_inflow"] > 1.0, m["gas_release_over_dissolved_inflow"]
-    # all-oil supply faces (ehlfoam.case.writer.supply_faces): 1.8 % here, 5.5 % with
+    # all-oil supply faces (ehlfoam.case.fields.supply_faces): 1.8 % here, 5.5 % with
     # part-oil faces, across which interPhaseChangeFoam compresses the interface. Over this
     # 1 ms the fluxes, sampled at 15 writes, fluctuate with the air (the oil's kinematic
     # viscosity, 60 times less than the other scenes'): interFoam with that air is off by

@@ -14,7 +14,7 @@ import pytest
 
 from bench.mesh_convergence import at_time
 from bench.rest_value import main as rest_value_main
-from ehlfoam.case.writer import META
+from ehlfoam.case.geometry import META
 from ehlfoam.metrics.convergence import METRICS, last_transit, observed_order, rest_value, window_mean
 from tests.tiny import tiny_geometry
 

@@ -24,7 +24,8 @@ import pytest
 from PIL import Image
 
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from ehlfoam.run.fields import time_folders
 from ehlfoam.report import add_parser, report, report_batch, report_case
 from ehlfoam.report import units

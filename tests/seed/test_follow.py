@@ -1,5 +1,5 @@
 """The following levels (``mesh.follow``): a mesh with bands of the level's cells along the
-meniscus of the state the case starts from (runs/follow_meniscus.py)."""
+meniscus of the state the case starts from (ehlfoam.seed.follow)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,8 @@ from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import make_case_spec
 from ehlfoam.spec.levels import FOLLOW_BASE, FOLLOW_LEVELS, FOLLOW_POLAR_RADIUS
 from ehlfoam.spec.mesh import RefineBand, SideBox
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from ehlfoam.seed.band import side_bands
 from tests.case.test_writer import EHLFOAM, _thin_film_state, _toml
 from tests.tiny import SMALL

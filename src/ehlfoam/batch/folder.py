@@ -93,7 +93,7 @@ def case_status(case: Path, live: bool = False) -> str:
     if live:
         return "running"
     if status == "running":
-        from ehlfoam.case.writer import META
+        from ehlfoam.case.geometry import META
 
         return "running" if lock_is_held(case / META / "run.lock") else "interrupted"
     return "interrupted" if status == "interrupted" else "pending"

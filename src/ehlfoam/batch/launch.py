@@ -86,7 +86,7 @@ def _spec_diff(a: Any, b: Any, prefix: str = "") -> list[str]:
 
 def check_finished_specs(batch_dir: Path, plan: list[PlannedCase]) -> None:
     """A finished case must have been built from the spec the plan gives it now."""
-    from ehlfoam.case.writer import load_spec_of
+    from ehlfoam.case.geometry import load_spec_of
 
     for pc in plan:
         case = batch_dir / CASES / pc.id

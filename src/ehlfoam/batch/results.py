@@ -39,7 +39,7 @@ def _cell(value: Any) -> str:
 def solver_log(case: Path) -> str:
     """The name of the case's solver log (log.interFoam, log.compressibleInterFoam)."""
     try:
-        from ehlfoam.case.writer import load_geometry
+        from ehlfoam.case.geometry import load_geometry
 
         return load_geometry(case).log_name
     except Exception:  # noqa: BLE001 - not built (yet), or an older geometry.json

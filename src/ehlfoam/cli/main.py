@@ -57,7 +57,8 @@ def cmd_case(args: argparse.Namespace) -> int:
     """Validate the spec, then build the case (precalc, mesh, OpenFOAM files)."""
     from ehlfoam.errors import SpecError
     from ehlfoam.spec.case import load_case_spec, make_case_spec
-    from ehlfoam.case.writer import CaseExists, mesh_warnings
+    from ehlfoam.case.geometry import mesh_warnings
+    from ehlfoam.case.writer import CaseExists
 
     overrides = dict(kv.split("=", 1) for kv in args.set or [])
     try:

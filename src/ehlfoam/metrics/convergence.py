@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.case.geometry import load_geometry, load_spec_of
 
 #: The flow-pattern metrics read over the meshes (metrics.json / history.csv keys).
 METRICS = ("inlet_meniscus_distance_over_a", "flooded_width_over_a", "flooded_length_over_a",

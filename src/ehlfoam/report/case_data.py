@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ehlfoam.case.writer import META, CaseGeometry
+from ehlfoam.case.geometry import META, CaseGeometry
 
 #: Lines of the solver log shown for a case that did not finish.
 LOG_TAIL_LINES = 30

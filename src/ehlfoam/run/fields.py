@@ -16,7 +16,8 @@ import numpy as np
 from foamlib import FoamFieldFile
 from scipy.spatial import cKDTree
 
-from ehlfoam.case.writer import AIR_GAS_CONSTANT, META, CaseGeometry
+from ehlfoam.case.dictionaries import AIR_GAS_CONSTANT
+from ehlfoam.case.geometry import META, CaseGeometry
 
 from ehlfoam.metrics import pattern as metrics
 

@@ -38,7 +38,7 @@ from foamlib import FoamFile
 
 from ehlfoam._io import atomic_write_json, atomic_write_text
 from ehlfoam.spec.case import CaseSpec
-from ehlfoam.case.writer import META, CaseGeometry, load_geometry, load_spec_of, mesh_warnings
+from ehlfoam.case.geometry import META, CaseGeometry, load_geometry, load_spec_of, mesh_warnings
 from ehlfoam.mesh import size_function
 
 from ehlfoam.run import fields as case_fields

@@ -3,9 +3,8 @@
 The levels of :data:`~ehlfoam.spec.levels.RESOLUTIONS` leave the meniscus in their base cells,
 and the flooded width does not converge over them; with bands of cells along the whole
 meniscus, twice as fine on the region's sides, and one thin wall cell everywhere
-(:data:`~ehlfoam.spec.levels.FOLLOW_LEVELS`), the
-meniscus is resolved on every level (docs/cases.md, "Resolved levels"). A case of such a
-level is written in three steps:
+(:data:`~ehlfoam.spec.levels.FOLLOW_LEVELS`), the meniscus is resolved on every level (see
+docs/models.md). A case of such a level is written in three steps:
 
 1. a probe case on the level's base mesh, without bands, started from the source
    (``--start-from``: a run case, a case snapshot or a thin-film state);
@@ -26,7 +25,8 @@ from pathlib import Path
 from typing import Any
 
 from ehlfoam.spec.case import CaseSpec, make_case_spec
-from ehlfoam.case.writer import CaseExists, CaseGeometry, write_case
+from ehlfoam.case.geometry import CaseGeometry
+from ehlfoam.case.writer import CaseExists, write_case
 
 from ehlfoam.seed.band import meniscus_bands, meniscus_lines, side_bands
 from ehlfoam.seed.start import seed_case

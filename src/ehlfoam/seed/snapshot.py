@@ -32,7 +32,7 @@ import numpy as np
 from foamlib import FoamFieldFile
 
 from ehlfoam._io import atomic_write
-from ehlfoam.case.writer import META, load_geometry
+from ehlfoam.case.geometry import META, load_geometry
 
 from ehlfoam.run.fields import Structure, time_folders, write_near
 from ehlfoam.seed.mapping import LayeredMesh, carry_oil, interpolate

@@ -29,7 +29,7 @@ import numpy as np
 from foamlib import FoamFieldFile
 
 from ehlfoam._io import atomic_write_json
-from ehlfoam.case.writer import META, load_geometry
+from ehlfoam.case.geometry import META, load_geometry
 
 from ehlfoam.run.fields import Structure, time_folders
 from ehlfoam.seed.mapping import LayeredMesh, carry_oil, interpolate

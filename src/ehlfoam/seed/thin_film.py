@@ -21,7 +21,7 @@ from foamlib import FoamFieldFile
 
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state
-from ehlfoam.case.writer import wall_layers_fraction
+from ehlfoam.case.fields import wall_layers_fraction
 
 from ehlfoam.run.fields import Structure
 from ehlfoam.seed.mapping import relative_heights
