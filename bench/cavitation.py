@@ -32,7 +32,7 @@ from ehlfoam.spec.case import load_case_spec
 from ehlfoam.case.geometry import load_geometry
 from ehlfoam.case.writer import write_case
 from ehlfoam.run import fields as case_fields
-from ehlfoam.seed.start import seed_from_previous
+from ehlfoam.seed.previous import seed_from_previous
 from ehlfoam.run.monitor import mass_balance, run_case
 
 RESULTS = ROOT / "bench" / "results"

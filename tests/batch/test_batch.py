@@ -32,7 +32,7 @@ from ehlfoam.batch.executors import parse_slurm, slurm_cluster
 from ehlfoam.batch.folder import CASES
 from ehlfoam.batch.results import FIXED_COLUMNS, read_results
 from ehlfoam.run.fields import time_folders
-from ehlfoam.seed.start import seed_from_previous
+from ehlfoam.seed.previous import seed_from_previous
 
 ROOT = Path(__file__).resolve().parents[2]
 BATCH = [sys.executable, "-m", "ehlfoam.cli.batch"]

@@ -695,7 +695,7 @@ def test_gas_release_flow_does_not_remember_the_initial_air(tmp_path):
 def test_cavitating_case_starts_from_another_cases_fields(tmp_path):
     """A ramp step of the cavitating scene: the previous case's final fields (lists, p and T
     included) as the start; the case must read them (no $internalField in list fields)."""
-    from ehlfoam.seed.start import seed_from_previous
+    from ehlfoam.seed.previous import seed_from_previous
 
     first, second = tmp_path / "first", tmp_path / "second"
     write_case(make_case_spec({**SMALL, "scene": "cavitating"}), first)

@@ -36,7 +36,7 @@ from ehlfoam.case.geometry import META, load_geometry
 
 from ehlfoam.run.fields import Structure, time_folders, write_near
 from ehlfoam.seed.mapping import LayeredMesh, carry_oil, interpolate
-from ehlfoam.seed.start import check_same_gap, write_seed
+from ehlfoam.seed.write import check_same_gap, write_seed
 
 #: The ``kind`` entry that tells a snapshot from a thin-film state (both are .npz).
 KIND = "ehlfoam-case-snapshot"
@@ -160,8 +160,8 @@ def map_snapshot(case: Path, s: Structure, snapshot: Path, names: Iterable[str]
                  ) -> tuple[dict[str, np.ndarray], dict[str, Any] | None, dict[str, Any]]:
     """The snapshot's fields among ``names`` interpolated onto ``case``'s mesh (its loaded
     :class:`Structure` ``s``), the oil at its source's volume: (fields, how the oil was
-    carried over (:func:`.field_mapping.carry_oil`; None without alpha.oil), the snapshot's
-    record). Raises :class:`.ramp.RampError` for a snapshot of another contact (its gaps
+    carried over (:func:`.mapping.carry_oil`; None without alpha.oil), the snapshot's
+    record). Raises :class:`.write.RampError` for a snapshot of another contact (its gaps
     differ from the case's)."""
     source, their_gap, fields, record = load_snapshot(snapshot)
     target = LayeredMesh.of(s)
@@ -183,7 +183,7 @@ def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]
     layer by layer onto its mesh (:func:`map_snapshot`; the same mesh gets its own values
     back, to the snapshot's precision). Returns (and writes to ``case/ehlfoam/ramp.json``)
     {"previous", "previous_time_s", "method": "snapshot", "fields", "cells", "source", "oil"
-    (how the oil was carried over, :func:`.field_mapping.carry_oil`)}."""
+    (how the oil was carried over, :func:`.mapping.carry_oil`)}."""
     case, snapshot = Path(case).absolute(), Path(snapshot).absolute()
     own = [name for name in FIELDS if (case / "0.orig" / name).is_file()]
     out, oil, record = map_snapshot(case, Structure.load(case), snapshot, own)

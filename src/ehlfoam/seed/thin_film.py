@@ -25,7 +25,7 @@ from ehlfoam.case.fields import wall_layers_fraction
 
 from ehlfoam.run.fields import Structure
 from ehlfoam.seed.mapping import relative_heights
-from ehlfoam.seed.start import check_same_gap, write_seed
+from ehlfoam.seed.write import check_same_gap, write_seed
 
 
 def _state_gap(sol: ThinFilmSolution, x: np.ndarray, y: np.ndarray) -> np.ndarray:
