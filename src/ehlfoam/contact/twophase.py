@@ -93,7 +93,6 @@ def solve_subambient(P0: np.ndarray, H: np.ndarray, h: float, prob: Problem,
     interior = np.zeros(P.shape, dtype=bool)
     interior[1:-1, 1:-1] = True  # with a zero-gradient outlet the last column is a ghost
     free = interior & (P0 <= p_fixed)
-    at_floor = np.zeros_like(free)
     r = np.zeros_like(P)
     wedge = np.zeros_like(P)
     f0 = np.zeros_like(P)
