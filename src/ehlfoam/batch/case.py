@@ -20,7 +20,7 @@ from pathlib import Path
 
 from ehlfoam._io import atomic_write_text
 from ehlfoam.batch.folder import CASES, LOCKS, SPEC_COPY, case_status, file_lock, metrics_or_none
-from ehlfoam.batch.spec import PlannedCase, load_plan
+from ehlfoam.batch.plan import PlannedCase, load_plan
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 
 #: How long a worker waits for a case still held by a stopping process (the solver's

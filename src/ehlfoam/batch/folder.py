@@ -3,12 +3,14 @@
 Layout of a batch folder (``runs/NAME/`` for ``runs/NAME.toml``)::
 
     batch.toml          verbatim copy of the batch spec
-    plan.json           the expanded plan: [{"id", "params", "ramp"}, ...]
+    plan.json           the expanded plan: [{"id", "params", "ramp"}, ...]; params: the case
+                        spec's dotted keys in SI (ehlfoam.batch.plan)
     cases/<id>/         one case each (ehlfoam.case.writer.write_case + ehlfoam.run.monitor.run_case):
                         metrics.json (the single source of truth), history.csv, log.interFoam
     results.csv         one row per planned case, rebuilt atomically from the metrics.json files
                         (ehlfoam.batch.results)
-    regime/             regime-map PNGs and regime.json (ehlfoam.batch.regime)
+    regime/             regime.json: the regime analysis (ehlfoam.batch.regime), SI
+    report/             the batch report (ehlfoam.report), with the regime pictures
     locks/<id>.lock     held by the process that builds and runs the case
     batch.lock          held by the ``ehlfoam batch`` process
 """

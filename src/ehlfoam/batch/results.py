@@ -13,13 +13,13 @@ from ehlfoam._io import atomic_write_text
 from ehlfoam.metrics.record import MetricsRecord
 
 from ehlfoam.batch.folder import CASES, RESULTS, case_status, metrics_or_none
-from ehlfoam.batch.spec import PlannedCase
+from ehlfoam.batch.plan import PARAM_KEYS, PlannedCase
 
 LOG = "log.interFoam"
 
-#: results.csv: these columns first, then every other scalar of metrics.json.
-FIXED_COLUMNS = ("case_id", "speed_mm_s", "temperature_C", "load_N", "supply", "disc_layer_um",
-                 "ball_layer_um", "resolution", "ramp", "ramp_step", "ramp_direction", "status",
+#: results.csv: these columns first (the case's parameters: the case spec's dotted keys in
+#: SI), then any other swept key, then every other scalar of the metrics record, by its key.
+FIXED_COLUMNS = ("case_id", *PARAM_KEYS, "ramp", "ramp_step", "ramp_direction", "status",
                  "end_reason", "reason", "state", "wall_s", "cells", "case_dir", "log")
 
 

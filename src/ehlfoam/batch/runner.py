@@ -13,7 +13,7 @@ from ehlfoam.batch.case import oneline, precalc_cached, record_worker_lost
 from ehlfoam.batch.folder import CASES, LOCKS, STATUSES, case_status, file_lock, metrics_or_none
 from ehlfoam.batch.progress import Progress, sim_fraction
 from ehlfoam.batch.results import write_results
-from ehlfoam.batch.spec import PRECALC_CPU_S, PlannedCase, est_cpu_s
+from ehlfoam.batch.plan import PRECALC_CPU_S, PlannedCase, est_cpu_s
 from ehlfoam.metrics.record import MetricsRecord
 
 POLL_S = 0.5
