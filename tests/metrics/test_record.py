@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ehlfoam.metrics import convergence
 from ehlfoam.metrics.pattern import Geometry, flow_pattern
 from ehlfoam.metrics.record import (LEGACY_KEYS, SCHEMA_PATH, SCHEMA_VERSION, MetricsRecord,
                                     display_of, read_metrics, schema_text, write_metrics)
@@ -57,7 +58,8 @@ def test_every_key_has_a_description_a_unit_and_a_display():
 
 
 def test_the_flow_pattern_and_the_history_speak_the_record():
-    """Every key the flow-pattern metrics and a history row give is a record key."""
+    """Every key the flow-pattern metrics, a history row and the convergence readings use is
+    a record key."""
     geom = Geometry(a=1e-4, island_radius=1.5e-4, x_min=-1e-3, x_max=1.2e-3, y_max=8e-4,
                     symmetric=False)
     x, y = np.meshgrid(np.linspace(-1e-3, 1.2e-3, 60), np.linspace(-8e-4, 8e-4, 40))
@@ -69,6 +71,7 @@ def test_the_flow_pattern_and_the_history_speak_the_record():
     assert set(row) - history_only <= set(MetricsRecord.model_fields)
     record = MetricsRecord.model_validate(pattern)
     assert record.state == pattern["state"] and not record.model_extra
+    assert set(convergence.METRICS) <= set(MetricsRecord.model_fields)
 
 
 def test_written_record_keeps_only_its_keys(tmp_path):
