@@ -57,6 +57,12 @@ def _plan(data: dict):
      ["base: invalid case spec: mesh.levels: unknown key"]),
     ({"sweep": {"contact.speed": {"start": 0.005, "stop": 0.025}}},
      ["a range needs start, stop"]),
+    ({"sweep": {"speed_mm_s": [5, 8]}},
+     ["speed_mm_s = [5, 8]: the batch spec takes the case spec's keys in SI: give "
+      "contact.speed in m/s"]),
+    ({"sweep": {"supply": [1, "flooded"]}}, ["supply = [1, 'flooded']: supply takes supply "
+                                             "tables"]),
+    ({"ramp": [{"name": "A", "speed_mm_s": [5, 8]}]}, ["give contact.speed in m/s"]),
 ])
 def test_bad_specs_name_key_value_and_range(data, expected):
     with pytest.raises(SpecError) as err:

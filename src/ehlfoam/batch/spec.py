@@ -172,11 +172,27 @@ def overrides(key: str, value: Any) -> dict[str, Any]:
     return {key: value}
 
 
+#: The batch spec's keys before it took the case spec's: old key -> what to write now.
+RENAMED = {"speed_mm_s": "contact.speed in m/s (e.g. [0.005, 0.008])",
+           "temperature_C": "contact.temperature", "load_N": "contact.load",
+           "resolution": "mesh.resolution"}
+_SUPPLY_HELP = ("supply takes supply tables: [{disc_layer = 1e-6, ball_layer = 1e-6}, "
+                "{mode = \"flooded\"}] (layers in m)")
+
+
 def _case_keys(table: dict[str, Any]) -> dict[str, Any]:
-    """A table of case-spec keys, dotted; the case name is not one of them (it is the id)."""
+    """A table of case-spec keys, dotted; the case name is not one of them (it is the id),
+    and a key of the batch spec's old names says what it is now."""
     flat = flatten(table)
     if "name" in flat:
         raise ValueError("name: the case name is the case id, it cannot be set here")
+    for key, value in flat.items():
+        if key in RENAMED:
+            raise ValueError(f"{key} = {value!r}: the batch spec takes the case spec's keys in "
+                             f"SI: give {RENAMED[key]}")
+        items = value if isinstance(value, list) else [value]
+        if key == "supply" and any(not isinstance(v, dict) for v in items):
+            raise ValueError(f"supply = {value!r}: {_SUPPLY_HELP}")
     return flat
 
 
