@@ -93,26 +93,28 @@ def draw_history(history: dict[str, np.ndarray], out: Path, *, title: str,
     shade = (t_ms[-1] - window * 1e3, t_ms[-1]) if st.window_s is not None else None
 
     ax = axes[0]
+    vol = units.METRICS["oil_volume_m3"]            # bubble_volume_m3 is shown alike
     v = history.get("oil_volume_m3")
     if v is not None:
-        ax.plot(t_ms, v * 1e12, color="tab:brown", lw=1.4, marker=".", ms=3, label="oil")
+        ax.plot(t_ms, v * vol.scale, color="tab:brown", lw=1.4, marker=".", ms=3, label="oil")
         if shade:
-            ax.fill_between(shade, v[-1] * 1e12 * (1 - tol), v[-1] * 1e12 * (1 + tol),
+            ax.fill_between(shade, v[-1] * vol.scale * (1 - tol), v[-1] * vol.scale * (1 + tol),
                             color="tab:green", alpha=0.2, lw=0, label=f"+-{tol:.0%} of last")
     bv = history.get("bubble_volume_m3")
     if bv is not None and np.isfinite(bv).any():
-        ax.plot(t_ms, bv * 1e12, color=style.BUBBLE_RGB, lw=1.2, label="bubble (gas)")
-    ax.set_ylabel("volume [nl]")
+        ax.plot(t_ms, bv * vol.scale, color=style.BUBBLE_RGB, lw=1.2, label="bubble (gas)")
+    ax.set_ylabel(f"volume [{vol.unit}]")
     _panel_title(ax, "oil volume (whole contact)")
     ax.legend(fontsize=7.5, loc="lower right")
 
     ax = axes[1]
+    flow = units.METRICS["oil_inflow_m3_s"]         # history.csv's oil_in_m3_s, oil_out_m3_s
     for key, label, colour in (("oil_in_m3_s", "in", "tab:blue"),
                                ("oil_out_m3_s", "out", "tab:orange")):
         col = history.get(key)
         if col is not None:
-            ax.plot(t_ms, col * 1e12, lw=1.2, color=colour, label=f"oil {label}")
-    ax.set_ylabel("flow [nl/s]")
+            ax.plot(t_ms, col * flow.scale, lw=1.2, color=colour, label=f"oil {label}")
+    ax.set_ylabel(f"flow [{flow.unit}]")
     _panel_title(ax, "oil through the open boundaries")
     ax.legend(fontsize=7.5, loc="lower right")
 
@@ -199,9 +201,9 @@ def fit_bubble_relation(xs: np.ndarray, ls: np.ndarray, temperature: float) -> F
 
 def draw_bubble_vs_speed(points: list[dict], out: Path, *, label: str,
                          dpi: int = style.DPI) -> tuple[Path, list[Fit]]:
-    """l/a against u (in its display unit), one colour per temperature. Fitted: state I cases with a
-    bubble (l > 0), filled; not fitted: state II (open wake, hollow) and state I without a
-    bubble (l = 0, crosses). ``points``: dicts with speed [m/s], temperature [C], l_over_a,
+    """l/a against u (in its display unit), one colour per temperature. Fitted: state I cases
+    with a bubble (l > 0), filled; not fitted: state II (open wake, hollow) and state I
+    without a bubble (l = 0, crosses). ``points``: dicts with speed [m/s], temperature [C], l_over_a,
     x (the relation's X), state."""
     fig = style.new_figure(9.0, 4.6, dpi)
     ax = fig.add_axes((0.08, 0.12, 0.52, 0.78))
