@@ -28,7 +28,7 @@ sys.path.insert(0, str(ROOT))
 
 from ehlfoam.batch.launch import BatchOptions, run_batch
 from ehlfoam.batch.results import read_results
-from ehlfoam.batch.spec import load_plan
+from ehlfoam.batch.plan import load_plan
 
 RESULTS = ROOT / "bench" / "results"
 
@@ -41,7 +41,7 @@ domain = {{ upstream = 5.0, downstream = 7.0, side = 5.0 }}
 supply = {{ mode = "layers", disc_layer = 3e-6, ball_layer = 3e-6, track_half_width = 2.5e-4, initial_puddle = 3.0 }}
 run = {{ end_time = {end_time!r}, writes_per_transit = 20 }}
 [sweep]
-speed_mm_s = {speeds}
+contact.speed = {speeds}
 supply = {supplies}
 """
 
@@ -49,8 +49,10 @@ supply = {supplies}
 def _spec(work: Path, args) -> Path:
     work.mkdir(parents=True, exist_ok=True)
     path = work / "throughput.toml"
-    path.write_text(BASE.format(end_time=args.end_time, speeds=list(args.speeds),
-                                supplies=list(args.supplies)))
+    supplies = ", ".join(f"{{disc_layer = {um * 1e-6!r}, ball_layer = {um * 1e-6!r}}}"
+                         for um in args.supplies)            # --speeds in mm/s, --supplies in um
+    path.write_text(BASE.format(end_time=args.end_time, speeds=[u * 1e-3 for u in args.speeds],
+                                supplies=f"[{supplies}]"))
     return path
 
 

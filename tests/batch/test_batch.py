@@ -31,6 +31,7 @@ from ehlfoam.batch.launch import BatchError, BatchOptions, run_batch
 from ehlfoam.batch.executors import parse_slurm, slurm_cluster
 from ehlfoam.batch.folder import CASES
 from ehlfoam.batch.results import FIXED_COLUMNS, read_results
+from ehlfoam.metrics.record import SCHEMA_VERSION, MetricsRecord, read_metrics
 from ehlfoam.run.fields import time_folders
 from ehlfoam.seed.previous import seed_from_previous
 
@@ -52,12 +53,12 @@ SMALL = tomllib.loads(BASE)["base"]
 #: build failure), and a ramp 10 -> 20 -> 10 mm/s
 TINY = BASE + """
 [[sweep]]
-speed_mm_s = [10, 20]
+contact.speed = [0.01, 0.02]
 [[sweep]]
-speed_mm_s = [0.5]
+contact.speed = [0.0005]
 [[ramp]]
 name = "A"
-speed_mm_s = [10, 20]
+contact.speed = [0.01, 0.02]
 """
 FAILING = "u00.5_s3um_T40_F20_coarse"
 RAMP = ["rampA_up01_u10.0_s3um_T40_F20_coarse", "rampA_up02_u20.0_s3um_T40_F20_coarse",
@@ -85,13 +86,14 @@ def tiny(tmp_path_factory):
 
 # ------------------------------------------------------------------ bad input
 @pytest.mark.parametrize("body, expected", [
-    (BASE + "[sweep]\nspeed_mm_s = [10]\nspeeds = [5]\n", "sweep.speeds: unknown key"),
-    (BASE + "[sweep]\nspeed_mm_s = []\n", "sweep.speed_mm_s = []: empty sweep"),
-    (BASE + "[sweep]\nspeed_mm_s = [10, -5]\n",
-     "sweep.speed_mm_s = -5 mm/s gives an invalid case: contact.speed = -0.005: Input should "
-     "be greater than 0 (valid range 0 < contact.speed <= 100)"),
-    (BASE + "[[ramp]]\nname = \"A\"\n", "ramp[0].speed_mm_s: missing: a ramp needs its speeds"),
-    (BASE + "[[ramp]]\nname = \"A\"\nspeed_mm_s = []\n", "a ramp without speeds"),
+    (BASE + "[sweep]\ncontact.speed = [0.01]\nspeeds = [5]\n", "sweep: speeds: unknown key"),
+    (BASE + "[sweep]\ncontact.speed = []\n", "sweep.contact.speed = []: empty sweep"),
+    (BASE + "[sweep]\ncontact.speed = [0.01, -0.005]\n",
+     "sweep: contact.speed = -0.005: Input should be greater than 0 (valid range 0 < "
+     "contact.speed <= 100)"),
+    (BASE + "[[ramp]]\nname = \"A\"\n",
+     "ramp[0].contact.speed: missing: a ramp needs its speeds"),
+    (BASE + "[[ramp]]\nname = \"A\"\ncontact.speed = []\n", "a ramp without speeds"),
 ])
 def test_bad_batch_spec_fails_before_anything_is_built(tmp_path, capsys, body, expected):
     spec = _spec(tmp_path, "bad", body)
@@ -103,10 +105,17 @@ def test_bad_batch_spec_fails_before_anything_is_built(tmp_path, capsys, body, e
 
 
 def test_bad_spec_exit_code_from_the_command(tmp_path):
-    spec = _spec(tmp_path, "bad", BASE + "[sweep]\nspeed_mm_s = [10]\nload = [5]\n")
+    spec = _spec(tmp_path, "bad", BASE + "[sweep]\ncontact.speed = [0.01]\nload = [5]\n")
     proc = subprocess.run([*BATCH, str(spec)], capture_output=True, text=True, cwd=spec.parent)
-    assert proc.returncode == 2 and "sweep.load: unknown key" in proc.stderr
+    assert proc.returncode == 2 and "sweep: load: unknown key" in proc.stderr
     assert not (tmp_path / "bad").exists() and not (tmp_path / "runs").exists()
+
+
+def test_report_option_takes_the_reporting_function():
+    """The batch sits below the reports: it takes the function that makes its report."""
+    with pytest.raises(TypeError, match="ehlfoam.report.after_batch"):
+        BatchOptions(report=True)
+    assert BatchOptions().report is None and BatchOptions(report=False).report is False
 
 
 def test_parser_registration_and_dry_run(tmp_path, capsys):
@@ -134,19 +143,26 @@ def test_batch_layout_and_results(tiny):
     plan = json.loads((batch / "plan.json").read_text())
     assert [p["id"] for p in plan] == ["u10.0_s3um_T40_F20_coarse", "u20.0_s3um_T40_F20_coarse",
                                        FAILING, *RAMP]
-    assert plan[0]["params"] == {"speed_mm_s": 10.0, "temperature_C": 40.0, "load_N": 20.0,
-                                 "supply": "layers", "disc_layer_um": 3.0, "ball_layer_um": 3.0,
-                                 "resolution": "coarse"}
+    assert plan[0]["params"] == {"contact.speed": 0.01, "contact.temperature": 40.0,
+                                 "contact.load": 20.0, "supply.mode": "layers",
+                                 "supply.disc_layer": 3e-6, "supply.ball_layer": 3e-6,
+                                 "mesh.resolution": "coarse"}
     assert plan[0]["ramp"] is None
     assert plan[5]["ramp"] == {"name": "A", "step": 3, "direction": "down", "previous": RAMP[1]}
     with open(batch / "results.csv", newline="") as fh:
         reader = csv.DictReader(fh)
         assert tuple(reader.fieldnames[:len(FIXED_COLUMNS)]) == FIXED_COLUMNS
         assert "oil_volume_m3" in reader.fieldnames and "time_steps" in reader.fieldnames
+        # every metrics column is a key of the metrics record
+        assert set(reader.fieldnames[len(FIXED_COLUMNS):]) <= set(MetricsRecord.model_fields)
         rows = {r["case_id"]: r for r in reader}
     assert list(rows) == [p["id"] for p in plan]
     ok = rows["u10.0_s3um_T40_F20_coarse"]
     assert ok["status"] == "finished" and ok["end_reason"] == "end_time"
+    assert float(ok["contact.speed"]) == 0.01 and ok["supply.mode"] == "layers"
+    m = read_metrics(batch / ok["case_dir"])
+    assert m.schema_version == SCHEMA_VERSION and m.case_id == ok["case_id"]
+    assert float(ok["oil_volume_m3"]) == m.oil_volume_m3 and not m.model_extra
     assert ok["state"] in ("I", "II") and float(ok["wall_s"]) > 0 and int(ok["cells"]) > 0
     assert (batch / ok["case_dir"] / "metrics.json").is_file() and (batch / ok["log"]).is_file()
     bad = rows[FAILING]
@@ -154,8 +170,8 @@ def test_batch_layout_and_results(tiny):
     assert (batch / bad["case_dir"] / "error.log").is_file()
     assert rows[RAMP[2]]["ramp"] == "A" and rows[RAMP[2]]["ramp_direction"] == "down"
     regime = json.loads((batch / "regime" / "regime.json").read_text())
-    assert regime["ramps"][0]["name"] == "A" and regime["figures"]
-    assert all((batch / f).is_file() for f in regime["figures"])
+    assert regime["ramps"][0]["name"] == "A"
+    assert regime["ramps"][0]["up"]["contact.speed"] == [0.01, 0.02]
 
 
 def test_ramp_step_starts_from_the_previous_final_fields(tiny):
@@ -204,7 +220,7 @@ def test_ramp_starts_from_a_run_case(tiny, tmp_path, capsys):
     finished step of the tiny batch), not from the puddle; a folder that has not run is
     refused before anything is built."""
     source = tiny[1].batch_dir / CASES / RAMP[1]
-    ramp = "[[ramp]]\nname = \"S\"\nspeed_mm_s = [15, 25]\nbranches = \"up\"\n"
+    ramp = "[[ramp]]\nname = \"S\"\ncontact.speed = [0.015, 0.025]\nbranches = \"up\"\n"
     bad = _spec(tmp_path, "bad", BASE + ramp + f"start_from = \"{tmp_path}\"\n")
     assert batch_cli.main([str(bad), "--quiet"]) == 2
     err = capsys.readouterr().err
@@ -229,7 +245,7 @@ def test_ramp_steps_with_mesh_follow_follow_the_meniscus_they_start_from(tiny, t
     base = BASE.replace("wall_grading = 3.0 }",
                         "wall_grading = 3.0, follow = { half_width = 0.5 } }")
     assert base != BASE
-    ramp = "[[ramp]]\nname = \"F\"\nspeed_mm_s = [15, 25]\nbranches = \"up\"\n"
+    ramp = "[[ramp]]\nname = \"F\"\ncontact.speed = [0.015, 0.025]\nbranches = \"up\"\n"
     spec = _spec(tmp_path, "follow", base + ramp + f"start_from = \"{source}\"\n")
     outcome = run_batch(spec, BatchOptions(out=spec.with_suffix(""), jobs=1, quiet=True, report=False))
     assert outcome.exit_code == 0
@@ -261,7 +277,8 @@ def test_rerun_keeps_finished_and_failed_cases(tiny):
 
 def test_failed_ramp_step_leaves_the_later_steps_pending(tmp_path):
     """A ramp whose first step cannot be built (0.5 mm/s: the precalc does not converge)."""
-    spec = _spec(tmp_path, "ramp", BASE + "[[ramp]]\nname = \"B\"\nspeed_mm_s = [0.5, 10]\n")
+    spec = _spec(tmp_path, "ramp",
+                 BASE + "[[ramp]]\nname = \"B\"\ncontact.speed = [0.0005, 0.01]\n")
     outcome = run_batch(spec, BatchOptions(out=spec.with_suffix(""), jobs=2, quiet=True, report=False))
     assert outcome.exit_code == 1 and outcome.ran == ["rampB_up01_u00.5_s3um_T40_F20_coarse"]
     rows = read_results(outcome.batch_dir)
@@ -330,8 +347,9 @@ def test_slurm_cluster_is_configured_for_mpi_cases():
 KILL = BASE.replace("end_time = 1e-3, writes_per_transit = 1000",
                     "end_time = 2e-2, writes_per_transit = 100") + """
 [sweep]
-speed_mm_s = [10, 20]
-supply = [2, 3, 4]
+contact.speed = [0.01, 0.02]
+supply = [{disc_layer = 2e-6, ball_layer = 2e-6}, {disc_layer = 3e-6, ball_layer = 3e-6},
+          {disc_layer = 4e-6, ball_layer = 4e-6}]
 """
 
 

@@ -33,6 +33,7 @@ from ehlfoam.report.charts import bubble_relation_x, fit_bubble_relation
 from ehlfoam.report.fields import load_fields
 from ehlfoam.report.side_view import cut_at_axis
 from ehlfoam.report.style import AIR_RGB, OIL_RGB
+from ehlfoam.batch.regime import write_regime
 from ehlfoam.run.monitor import run_case
 from tests.tiny import SMALL
 
@@ -239,18 +240,21 @@ def batch(finished_case, case_report, tmp_path_factory) -> Path:
     shutil.copytree(finished_case, ok)                       # with its report/
     _failed_copy(finished_case, root / "cases" / "bad")
     m = json.loads((ok / "metrics.json").read_text())
-    columns = ["case_id", "speed_mm_s", "temperature_C", "load_N", "supply", "disc_layer_um",
-               "ball_layer_um", "status", "end_reason", "reason", "state", "wall_s", "cells",
-               "case_dir", "log", "inlet_meniscus_distance_over_a", "wake_gas_length_over_a"]
-    rows = [{"case_id": "ok", "speed_mm_s": 20, "temperature_C": 40, "load_N": 20,
-             "supply": "layers", "disc_layer_um": 3, "ball_layer_um": 3,
+    columns = ["case_id", "contact.speed", "contact.temperature", "contact.load",
+               "supply.mode", "supply.disc_layer", "supply.ball_layer", "status", "end_reason",
+               "reason", "state", "wall_s", "cells", "case_dir", "log",
+               "inlet_meniscus_distance_over_a", "wake_gas_length_over_a"]
+    rows = [{"case_id": "ok", "contact.speed": 0.02, "contact.temperature": 40,
+             "contact.load": 20, "supply.mode": "layers", "supply.disc_layer": 3e-6,
+             "supply.ball_layer": 3e-6,
              "status": "finished", "end_reason": "end_time", "reason": "", "state": m["state"],
              "wall_s": m["wall_s"], "cells": m["cells"], "case_dir": "cases/ok",
              "log": "cases/ok/log.interFoam",
              "inlet_meniscus_distance_over_a": m["inlet_meniscus_distance_over_a"],
              "wake_gas_length_over_a": m["wake_gas_length_over_a"]},
-            {"case_id": "bad", "speed_mm_s": 40, "temperature_C": 40, "load_N": 20,
-             "supply": "layers", "disc_layer_um": 3, "ball_layer_um": 3, "status": "failed",
+            {"case_id": "bad", "contact.speed": 0.04, "contact.temperature": 40,
+             "contact.load": 20, "supply.mode": "layers", "supply.disc_layer": 3e-6,
+             "supply.ball_layer": 3e-6, "status": "failed",
              "end_reason": "diverged", "reason": "solver diverged: time step collapsed",
              "state": "", "wall_s": 3.0, "cells": m["cells"], "case_dir": "cases/bad",
              "log": "cases/bad/log.interFoam"}]
@@ -262,10 +266,11 @@ def batch(finished_case, case_report, tmp_path_factory) -> Path:
             {"id": "bad", "params": {"contact.speed": 0.04}, "ramp": None},
             {"id": "later", "params": {"contact.speed": 0.06}, "ramp": None}]
     (root / "plan.json").write_text(json.dumps(plan))
-    (root / "regime").mkdir()
-    shutil.copy(ok / "report" / "thumb.png", root / "regime" / "map.png")
-    (root / "regime" / "regime.json").write_text(json.dumps(
-        {"summary": ["T 40 C, F 20 N, 1um, coarse: I -> II at 12.5 +- 2.5 mm/s"]}))
+    line = [{"case_id": f"u{u}", "contact.speed": u * 1e-3, "contact.temperature": 40.0,
+             "contact.load": 20.0, "supply.mode": "layers", "supply.disc_layer": 1e-6,
+             "supply.ball_layer": 1e-6, "mesh.resolution": "coarse", "status": "finished",
+             "state": state} for u, state in ((10, "I"), (15, "II"))]
+    write_regime(root, line)
     return root
 
 
@@ -284,8 +289,9 @@ def test_batch_report_index_failures_and_reuse(batch):
     assert (index.parent / "../cases/bad/log.interFoam").resolve().is_file()
     assert LOG_MARKER in html                                  # its last log line
     assert "later" in html and "pending" in html
-    assert "I -&gt; II at 12.5 +- 2.5 mm/s" in html              # regime.json's summary
-    assert 'src="../regime/map.png"' in html
+    assert "T 40 C, F 20 N, 1um, coarse: I -&gt; II at 12.5 +- 2.5 mm/s" in html  # regime.json
+    assert 'src="regime_speed_supply.png"' in html and "u [mm/s]" in html
+    assert "3 / 3" in html                                      # the layers in um
     assert "not enough points" in html                          # one state I point only
     for src in re.findall(r'<img src="([^"]+)"', html):
         assert (index.parent / src).resolve().is_file(), src
@@ -364,7 +370,7 @@ def test_batch_report_reads_the_mesh_convergence_of_three_levels(finished_case, 
     0.8 / 0.55 / 0.38 a, their histories rewritten: a width that follows 12 + 3 h^2 reads as
     converging at order 2 towards 12 a; an inlet meniscus whose level means differ by less
     than its own jitter reads as within noise. A fourth case at another speed is left out."""
-    from ehlfoam.report.batch import convergence_groups
+    from ehlfoam.report.batch_tables import convergence_groups
 
     root = tmp_path / "conv"
     sizes = {"coarse": 0.8, "medium": 0.55, "fine": 0.38}
@@ -384,11 +390,13 @@ def test_batch_report_reads_the_mesh_convergence_of_three_levels(finished_case, 
             w = csv.DictWriter(fh, fieldnames=list(hist[0]))
             w.writeheader()
             w.writerows(hist)
-        rows.append({"case_id": level, "speed_mm_s": 20, "temperature_C": 40, "load_N": 20,
-                     "supply": "layers", "disc_layer_um": 3, "ball_layer_um": 3,
-                     "resolution": level, "status": "finished", "case_dir": f"cases/{level}"})
+        rows.append({"case_id": level, "contact.speed": 0.02, "contact.temperature": 40,
+                     "contact.load": 20, "supply.mode": "layers", "supply.disc_layer": 3e-6,
+                     "supply.ball_layer": 3e-6, "mesh.resolution": level,
+                     "status": "finished", "case_dir": f"cases/{level}"})
     _copy(finished_case, root / "cases" / "other")
-    rows.append({**rows[0], "case_id": "other", "speed_mm_s": 40, "case_dir": "cases/other"})
+    rows.append({**rows[0], "case_id": "other", "contact.speed": 0.04,
+                 "case_dir": "cases/other"})
     with open(root / "results.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()

@@ -18,10 +18,10 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from ehlfoam._io import atomic_write_json, atomic_write_text
-
-from ehlfoam.batch.folder import CASES, LOCKS, SPEC_COPY, case_status, file_lock, read_metrics
-from ehlfoam.batch.spec import PlannedCase, load_plan
+from ehlfoam._io import atomic_write_text
+from ehlfoam.batch.folder import CASES, LOCKS, SPEC_COPY, case_status, file_lock, metrics_or_none
+from ehlfoam.batch.plan import PlannedCase, load_plan
+from ehlfoam.metrics.record import MetricsRecord, write_metrics
 
 #: How long a worker waits for a case still held by a stopping process (the solver's
 #: graceful stop takes up to ehlfoam.run.monitor.STOP_GRACE_S = 120 s).
@@ -141,37 +141,43 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
         except Exception as err:  # noqa: BLE001 - recorded, the batch goes on
             metrics = _record_failure(case, case_id, stage, err, t0)
             return {"id": case_id, "kind": "case", "status": "failed",
-                    "reason": metrics["reason"]}
+                    "reason": metrics.reason}
         metrics = _complete_metrics(case, metrics, case_id, build_s, seed, t0)
-        return {"id": case_id, "kind": "case", "status": metrics.get("status"),
-                "reason": metrics.get("reason", "")}
+        return {"id": case_id, "kind": "case", "status": metrics.status,
+                "reason": metrics.reason or ""}
 
 
-def _record_failure(case: Path, case_id: str, stage: str, err: Exception, t0: float) -> dict:
+def _failed(old: MetricsRecord | None, **values) -> MetricsRecord:
+    """A ``failed`` record: ``old``'s keys but its status, then ``values``."""
+    kept = {k: v for k, v in old.to_json().items() if k != "status"} if old else {}
+    return MetricsRecord.model_validate({**kept, "status": "failed", **values})
+
+
+def _record_failure(case: Path, case_id: str, stage: str, err: Exception,
+                    t0: float) -> MetricsRecord:
     """metrics.json ``failed`` with the reason, and the traceback in error.log."""
     case.mkdir(parents=True, exist_ok=True)
     atomic_write_text(case / "error.log", traceback.format_exc())
-    old = read_metrics(case) or {}
-    keep = old if old.get("status") == "running" else {}   # this attempt's run only
-    metrics = {**{k: v for k, v in keep.items() if k != "status"}, "status": "failed",
-               "end_reason": f"{stage.replace(' ', '_')}_error",
-               "reason": f"{stage}: {oneline(err)}", "case_id": case_id,
-               "case_wall_s": time.monotonic() - t0}
-    atomic_write_json(case / "metrics.json", metrics)
+    old = metrics_or_none(case)
+    keep = old if old is not None and old.status == "running" else None   # this attempt's
+    metrics = _failed(keep, end_reason=f"{stage.replace(' ', '_')}_error",
+                      reason=f"{stage}: {oneline(err)}", case_id=case_id,
+                      case_wall_s=time.monotonic() - t0)
+    write_metrics(case, metrics)
     return metrics
 
 
-def _failure_reason(metrics: dict) -> str:
-    if metrics.get("status") != "failed":
+def _failure_reason(metrics: MetricsRecord) -> str:
+    if metrics.status != "failed":
         return ""
-    tail = [ln.strip() for ln in metrics.get("log_tail") or [] if ln.strip()]
+    tail = [ln.strip() for ln in metrics.log_tail or [] if ln.strip()]
     last = tail[-1] if tail else ""
-    return (f"solver {metrics.get('end_reason')} (exit code {metrics.get('solver_exit_code')})"
+    return (f"solver {metrics.end_reason} (exit code {metrics.solver_exit_code})"
             + (f": {last[:300]}" if last else ""))
 
 
-def _complete_metrics(case: Path, metrics: dict, case_id: str, build_s: float | None,
-                      seed: dict | None, t0: float) -> dict:
+def _complete_metrics(case: Path, metrics: MetricsRecord, case_id: str,
+                      build_s: float | None, seed: dict | None, t0: float) -> MetricsRecord:
     """Add the batch's keys to the run's metrics.json (written once, by its own worker)."""
     extra = {"case_id": case_id, "build_wall_s": build_s,
              "case_wall_s": time.monotonic() - t0}
@@ -181,16 +187,14 @@ def _complete_metrics(case: Path, metrics: dict, case_id: str, build_s: float | 
     reason = _failure_reason(metrics)
     if reason:
         extra["reason"] = reason
-    metrics = {**metrics, **extra}
-    atomic_write_json(case / "metrics.json", metrics)
+    metrics = metrics.updated(**extra)
+    write_metrics(case, metrics)
     return metrics
 
 
 def record_worker_lost(case: Path, case_id: str, reason: str) -> None:
     """metrics.json ``failed`` (``worker_lost``): the process running the case died."""
     case.mkdir(parents=True, exist_ok=True)
-    old = read_metrics(case) or {}
-    atomic_write_json(case / "metrics.json", {**{k: v for k, v in old.items() if k != "status"},
-                                              "status": "failed", "end_reason": "worker_lost",
-                                              "reason": reason, "case_id": case_id})
+    write_metrics(case, _failed(metrics_or_none(case), end_reason="worker_lost",
+                                reason=reason, case_id=case_id))
 

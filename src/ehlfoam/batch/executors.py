@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from ehlfoam.batch.case import ensure_precalc, execute_case
-from ehlfoam.batch.spec import SpecError
+from ehlfoam.errors import SpecError
 
 PR_SET_PDEATHSIG = 1
 

@@ -10,10 +10,11 @@ from pathlib import Path
 from typing import Any
 
 from ehlfoam.batch.case import oneline, precalc_cached, record_worker_lost
-from ehlfoam.batch.folder import CASES, LOCKS, STATUSES, case_status, file_lock, read_metrics
+from ehlfoam.batch.folder import CASES, LOCKS, STATUSES, case_status, file_lock, metrics_or_none
 from ehlfoam.batch.progress import Progress, sim_fraction
 from ehlfoam.batch.results import write_results
-from ehlfoam.batch.spec import PRECALC_CPU_S, PlannedCase, est_cpu_s
+from ehlfoam.batch.plan import PRECALC_CPU_S, PlannedCase, est_cpu_s
+from ehlfoam.metrics.record import MetricsRecord
 
 POLL_S = 0.5
 
@@ -152,7 +153,7 @@ class BatchRunner:
             return
         case = self.batch_dir / CASES / task.key
         status = case_status(case)
-        m = read_metrics(case) or {}
+        m = metrics_or_none(case) or MetricsRecord()
         self.outcome[task.key] = status
         if status == "finished":
             wall = m.get("case_wall_s") or m.get("wall_s") or 0.0

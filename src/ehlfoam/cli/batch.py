@@ -80,6 +80,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
     from ehlfoam.batch.launch import BatchError, BatchOptions, dry_run, run_batch
     from ehlfoam.batch.executors import parse_slurm
+    from ehlfoam.report import after_batch
 
     try:
         if args.dry_run:
@@ -89,7 +90,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
         opts = BatchOptions(out=Path(args.out) if args.out else None, jobs=args.jobs,
                             cores=args.cores, rerun_failed=args.rerun_failed,
                             scheduler=args.scheduler, slurm=slurm, quiet=args.quiet,
-                            regime=not args.no_report, report=not args.no_report)
+                            regime=not args.no_report,
+                            report=None if args.no_report else after_batch)
         outcome = run_batch(args.spec, opts)
     except (SpecError, BatchError) as err:
         print(f"ehlfoam batch: {err}", file=sys.stderr)

@@ -2,6 +2,7 @@
 
     report_case(case_dir) -> CASE/report/index.html
     report_batch(batch_dir) -> BATCH/report/index.html
+    after_batch(batch_dir, log) -> the regime map's lines in the log, then report_batch
     report(dir)            -> whichever ``dir`` is
     add_parser(subparsers) -> registers ``ehlfoam report DIR``
 
@@ -16,7 +17,8 @@ from pathlib import Path
 
 from ehlfoam.report.case_report import report_case
 
-__all__ = ["add_parser", "is_batch", "is_case", "report", "report_batch", "report_case"]
+__all__ = ["add_parser", "after_batch", "is_batch", "is_case", "report", "report_batch",
+           "report_case"]
 
 
 def is_case(path: str | os.PathLike) -> bool:
@@ -37,6 +39,14 @@ def report_batch(batch_dir: str | os.PathLike, **kwargs) -> Path:
     from ehlfoam.report.batch import report_batch as _report_batch
 
     return _report_batch(batch_dir, **kwargs)
+
+
+def after_batch(batch_dir: str | os.PathLike, log) -> Path:
+    """What ``ehlfoam batch`` reports after its cases; see
+    :func:`ehlfoam.report.batch.after_batch`."""
+    from ehlfoam.report.batch import after_batch as _after_batch
+
+    return _after_batch(batch_dir, log)
 
 
 def report(path: str | os.PathLike, **kwargs) -> Path:

@@ -214,7 +214,7 @@ def source_oil(record: dict[str, Any], case: Path, s: Structure
 
 def snapshot_history(snapshot: str | Path) -> tuple[dict[str, np.ndarray], float]:
     """(history columns, transit time [s]) of the run a snapshot was taken from, its
-    history.csv up to the snapshot's write as :func:`ehlfoam.report.case_data.read_history`
+    history.csv up to the snapshot's write as :func:`ehlfoam.run.history.read_history`
     reads it; raises :class:`SnapshotError` when it kept none."""
     _require_snapshot(snapshot)
     with np.load(snapshot, allow_pickle=False) as d:   # the record only, not the fields
@@ -230,7 +230,7 @@ def snapshot_history_of(record: dict[str, Any]) -> tuple[dict[str, np.ndarray], 
     import csv
     import io
 
-    from ehlfoam.report.case_data import history_columns
+    from ehlfoam.run.history import history_columns
 
     columns = (history_columns(list(csv.DictReader(io.StringIO(record["history"]))))
                if record.get("history") else None)
