@@ -23,6 +23,7 @@ from foamlib import FoamFieldFile, FoamFile
 
 from ehlfoam._io import atomic_write_json, atomic_write_text
 from ehlfoam.foam.runtime import FoamRuntime
+from ehlfoam.notices import Notice
 
 from ehlfoam.case import face_oil
 from ehlfoam.spec.case import CaseSpec
@@ -484,17 +485,17 @@ def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int, solver: str) 
 BALL_WALL_STEPS_LIMIT = 10.0
 
 
-def mesh_warnings(geom: CaseGeometry) -> list[str]:
+def mesh_warnings(geom: CaseGeometry) -> list[Notice]:
     """What is wrong with a written case's mesh though it runs: the ball's wall cells
     stair-stepping above :data:`BALL_WALL_STEPS_LIMIT`. `ehlfoam case` prints these, and every
     run records them in metrics.json (``warnings``), which a batch shows."""
     if geom.ball_wall_steps <= BALL_WALL_STEPS_LIMIT:
         return []
-    return [f"the ball's wall cells step {geom.ball_wall_steps:.1f} of their heights across a "
-            f"cell (median; the levels give 7-9, above {BALL_WALL_STEPS_LIMIT:g} a spurious "
-            f"oil film creeps along the ball): thinner wall cells (mesh.n_layers, "
-            f"mesh.wall_grading) need finer in-plane cells (mesh.resolution, mesh.size_rim, "
-            f"mesh.size_far); docs/cases.md, \"Thinner wall cells: the ball's stair-steps\""]
+    return [Notice("ball-wall-steps",
+                   f"the ball's wall cells step {geom.ball_wall_steps:.1f} heights per cell "
+                   f"(above {BALL_WALL_STEPS_LIMIT:g}): a spurious oil film creeps along the "
+                   f"ball, thin mesh.n_layers need finer in-plane cells",
+                   "docs/models/mesh.md#wall-cells")]
 
 
 def case_mesh(spec: CaseSpec, gap) -> tuple[MeshParams, BaseMesh, PolyMesh, np.ndarray]:
