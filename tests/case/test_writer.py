@@ -24,7 +24,7 @@ from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import make_case_spec
 from ehlfoam.case.writer import (BALL_WALL_STEPS_LIMIT, CaseExists, capillary_time_step, load_geometry, load_spec_of, mesh_warnings, write_case)
 from ehlfoam.run import fields as case_fields
-from ehlfoam.cli.main import parse_value
+from ehlfoam.cli.case import parse_value
 from ehlfoam.foam.runtime import FoamRuntime
 from ehlfoam.report.case_data import read_history
 from ehlfoam.run.monitor import (FRONT_CELL_WARNING, OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, front_cell_warnings, rear_cell_warnings, run_case)
