@@ -9,8 +9,10 @@ Subcommands, one module each in :mod:`ehlfoam.cli`:
   snapshot a run case's state in one small file, to start other cases from
   report   an HTML report (pictures, plots, metrics) of a case or a batch
   batch    generate, run and report a batch of cases (sweeps, speed ramps)
+  foam     any OpenFOAM application through the configured runtime
 
-Exit codes: 0 ok, 1 failure, 2 bad input, 130 interrupted. The subcommand modules import only the standard library at the top, so
+Exit codes: 0 ok, 1 failure, 2 bad input, 130 interrupted (``ehlfoam foam``: the
+application's own). The subcommand modules import only the standard library at the top, so
 that ``--help`` is quick; numpy, scipy, pyvista, foamlib, gmsh and dask load in the commands.
 """
 
@@ -21,11 +23,11 @@ import os
 import sys
 from collections.abc import Sequence
 
-from ehlfoam.cli import band, batch, case, doctor, precalc, report, run, snapshot
+from ehlfoam.cli import band, batch, case, doctor, foam, precalc, report, run, snapshot
 from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED
 
 #: the subcommands, in the order ``ehlfoam --help`` lists them
-COMMANDS = (doctor, precalc, case, run, band, snapshot, report, batch)
+COMMANDS = (doctor, precalc, case, run, band, snapshot, report, batch, foam)
 
 
 def version() -> str:
