@@ -31,7 +31,7 @@ EXAMPLES = ("ehlfoam batch examples/batches/default.toml",
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    """The batch command's arguments (shared by the subcommand and the module's main)."""
+    """The batch command's arguments."""
     p.add_argument("spec", help="batch spec TOML (e.g. examples/batches/default.toml)")
     p.add_argument("--out", default=None,
                    help="batch folder (default: runs/STEM/ in the working directory for STEM.toml)")
