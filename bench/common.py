@@ -82,7 +82,7 @@ def solver_cpu_s(case: Path) -> float | None:
 def spec_option(text: str) -> tuple[str, Any]:
     """``KEY=VALUE`` of a spec option (dotted key, e.g. ``run.max_courant=1``), the value read
     as ``ehlfoam case --set`` reads it (the spec validates it); an argparse ``type``."""
-    from ehlfoam.cli.main import parse_value
+    from ehlfoam.cli.case import parse_value
 
     key, sep, value = text.partition("=")
     if not sep or not key:

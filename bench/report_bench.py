@@ -7,7 +7,7 @@ The sources are finished cases (default: runs/bench/supply_sweep/coarse/*). They
 written to: each report runs on a "shadow" of a case, a folder of symbolic links to the
 case's entries (the report writes only its own report/ folder). The batch is a fabricated
 batch folder (cases/<id>/ shadows, results.csv, plan.json, one failed case). Each report
-runs in a fresh process (``python -m ehlfoam.report``), so the timings include the imports, as
+runs in a fresh process (``python -m ehlfoam report``), so the timings include the imports, as
 ``ehlfoam report`` does. Prints a table and writes bench/results/report_bench.json.
 """
 
@@ -94,12 +94,12 @@ def fabricate_batch(out: Path, sources: list[Path], n: int, failed: int = 1) -> 
 
 
 def timed_report(path: Path, *extra: str) -> tuple[float, float]:
-    """(wall time, CPU time) [s] of ``python -m ehlfoam.report PATH`` in a fresh process; the
+    """(wall time, CPU time) [s] of ``python -m ehlfoam report PATH`` in a fresh process; the
     CPU time (user + system, the process and its workers) is what the report costs whatever
     else runs on the machine."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "ehlfoam.report", str(path), *extra], cwd=ROOT,
+    proc = subprocess.run([sys.executable, "-m", "ehlfoam", "report", str(path), *extra], cwd=ROOT,
                           capture_output=True, text=True)
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -27,10 +27,11 @@ from ehlfoam.case.timestep import capillary_time_step
 from ehlfoam.case.writer import CaseExists, write_case
 from ehlfoam.mesh import refinement_size
 from ehlfoam.run import fields as case_fields
-from ehlfoam.cli.main import parse_value
+from ehlfoam.cli.case import parse_value
 from ehlfoam.foam.runtime import FoamRuntime
 from ehlfoam.report.case_data import read_history
 from ehlfoam.run.monitor import (FRONT_CELL_WARNING, OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, front_cell_warnings, rear_cell_warnings, run_case)
+from ehlfoam.notices import to_text
 from tests.tiny import SMALL
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -911,7 +912,7 @@ def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path)
     assert "wall cells step" in runs["thin"].stderr and "mesh.n_layers" in runs["thin"].stderr
     # every run records it in metrics.json, which a batch's log and results.csv show
     warnings = mesh_warnings(load_geometry(tmp_path / "thin"))
-    assert [f"ehlfoam case: warning: {w}" for w in warnings] == [
+    assert [f"ehlfoam case: warning {w}" for w in warnings] == [
         ln for ln in runs["thin"].stderr.splitlines() if "warning" in ln]
     assert mesh_warnings(load_geometry(tmp_path / "own")) == []
     with FoamFile(tmp_path / "thin" / "system" / "controlDict") as f:
@@ -920,7 +921,7 @@ def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path)
     # after the mesh's warning, the coarse rear cells' of the same run, and its front's off
     # the track, where dry walls run into the puddle: the small case's cells there are tens
     # of its wall cells wide, past the contact-line strip's 15
-    assert m["status"] == "finished" and m["warnings"] == "; ".join(
+    assert m["status"] == "finished" and m["warnings"] == to_text(
         warnings + rear_cell_warnings(m["rear_meniscus_cell_over_a"])
         + front_cell_warnings(m["front_contact_line_cells_over_wall_cell"])), m
     assert m["front_contact_line_cells_over_wall_cell"] > FRONT_CELL_WARNING

@@ -27,7 +27,8 @@ from ehlfoam.spec.case import make_case_spec
 from ehlfoam.case.geometry import load_geometry
 from ehlfoam.case.writer import write_case
 from ehlfoam.run.fields import time_folders
-from ehlfoam.report import add_parser, report, report_batch, report_case
+from ehlfoam.cli.report import add_parser
+from ehlfoam.report import report, report_batch, report_case
 from ehlfoam.report import units
 from ehlfoam.report.charts import bubble_relation_x, fit_bubble_relation
 from ehlfoam.report.fields import load_fields
@@ -221,10 +222,10 @@ def test_report_detects_case_and_batch_and_bad_input(finished_case, tmp_path):
 
 
 def test_cli_module_off_screen(finished_case, tmp_path):
-    """``python -m ehlfoam.report CASE`` in a process with no display at all."""
+    """``python -m ehlfoam report CASE`` in a process with no display at all."""
     case = _copy(finished_case, tmp_path / "cli")
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-    proc = subprocess.run([sys.executable, "-m", "ehlfoam.report", str(case),
+    proc = subprocess.run([sys.executable, "-m", "ehlfoam", "report", str(case),
                            "--no-gif"], cwd=ROOT, env=env, capture_output=True, text=True,
                           timeout=120)
     assert proc.returncode == 0, proc.stderr

@@ -17,8 +17,8 @@ def test_a_region_spilling_over_the_side_is_flagged_and_one_inside_is_not():
     # the coarse level at size_far 0.2 a reaching the 8 a side: 53-61 % off the outlet
     spilling = off_outlet_share({"outlet": 0.45, "side": 0.55, "inlet": 0.0})
     [warning] = boundary_warnings(spilling)
-    assert warning.startswith("55% of the outflow left through the side or upstream")
-    assert "domain.side" in warning
+    assert warning.text.startswith("55% of the outflow left through the side or upstream")
+    assert "domain.side" in warning.text
     assert boundary_warnings(off_outlet_share({"outlet": 0.996, "side": 0.004})) == []
     assert boundary_warnings(OFF_OUTLET_WARNING) == []
     assert boundary_warnings(None) == []
@@ -28,11 +28,11 @@ def test_a_region_near_an_open_boundary_is_flagged():
     # a film-resolving run's rear meniscus at 13.5 a against the 14 a outlet
     [warning] = boundary_warnings(0.0, {"flooded_clearance_over_a": 0.5,
                                         "flooded_nearest_boundary": "outlet"})
-    assert warning.startswith("the flooded region is 0.50 a from the outlet boundary")
-    assert "domain.downstream" in warning
+    assert warning.text.startswith("the flooded region is 0.50 a from the outlet boundary")
+    assert "domain.downstream" in warning.text
     [warning] = boundary_warnings(None, {"flooded_clearance_over_a": 0.2,
                                          "flooded_nearest_boundary": "side"})
-    assert "domain.side" in warning
+    assert "domain.side" in warning.text
     assert boundary_warnings(0.0, {"flooded_clearance_over_a": CLEARANCE_WARNING,
                                    "flooded_nearest_boundary": "side"}) == []
     assert boundary_warnings(0.0, {"flooded_clearance_over_a": None,
@@ -58,8 +58,8 @@ def test_the_cells_at_the_rear_meniscus_are_read_off_the_spec_and_coarse_ones_fl
     assert rear_meniscus_cell(nominal, {"state": "I", "flooded_x_max_over_a": None}) is None
     assert rear_meniscus_cell(nominal, None) is None
     [warning] = rear_cell_warnings(far)
-    assert warning.startswith(f"the rear meniscus sits in {far:.2f} a cells")
-    assert "mesh.refine" in warning and "nominal_films.toml" in warning
+    assert warning.text.startswith(f"the rear meniscus sits in {far:.2f} a cells")
+    assert "mesh.refine" in warning.text and "nominal_films.toml" in warning.text
     assert rear_cell_warnings(0.1) == []
     assert rear_cell_warnings(REAR_CELL_WARNING) == []
     assert rear_cell_warnings(None) == []

@@ -9,6 +9,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from ehlfoam.notices import Notice
 from ehlfoam.spec.case import CaseSpec
 
 META = "ehlfoam"  # the case's own folder of generator outputs
@@ -80,17 +81,17 @@ class CaseGeometry:
 BALL_WALL_STEPS_LIMIT = 10.0
 
 
-def mesh_warnings(geom: CaseGeometry) -> list[str]:
+def mesh_warnings(geom: CaseGeometry) -> list[Notice]:
     """What is wrong with a written case's mesh though it runs: the ball's wall cells
     stair-stepping above :data:`BALL_WALL_STEPS_LIMIT`. `ehlfoam case` prints these, and every
     run records them in metrics.json (``warnings``), which a batch shows."""
     if geom.ball_wall_steps <= BALL_WALL_STEPS_LIMIT:
         return []
-    return [f"the ball's wall cells step {geom.ball_wall_steps:.1f} of their heights across a "
-            f"cell (median; the levels give 7-9, above {BALL_WALL_STEPS_LIMIT:g} a spurious "
-            f"oil film creeps along the ball): thinner wall cells (mesh.n_layers, "
-            f"mesh.wall_grading) need finer in-plane cells (mesh.resolution, mesh.size_rim, "
-            f"mesh.size_far); docs/cases.md, \"Thinner wall cells: the ball's stair-steps\""]
+    return [Notice("ball-wall-steps",
+                   f"the ball's wall cells step {geom.ball_wall_steps:.1f} heights per cell "
+                   f"(above {BALL_WALL_STEPS_LIMIT:g}): a spurious oil film creeps along the "
+                   f"ball, thin mesh.n_layers need finer in-plane cells",
+                   "docs/models/interface.md#warnings-a-run-gives")]
 
 
 def load_geometry(case: str | os.PathLike) -> CaseGeometry:

@@ -4,8 +4,7 @@ Exit codes: 0 every planned case finished; 1 some case failed or is not finished
 input (bad spec, busy folder, a finished case with another spec; nothing built);
 130 interrupted (Ctrl-C / SIGTERM; re-run the command to resume).
 
-Registered in ``runs/cli.py`` by ``batch_cli.add_parser(sub)``; also runs on its own:
-``python -m ehlfoam.cli.batch SPEC [options]``.
+Also runs on its own: ``python -m ehlfoam.cli.batch SPEC [options]``.
 """
 
 from __future__ import annotations
@@ -15,7 +14,8 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+from ehlfoam.cli.common import (EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, add_command,
+                                positive_int)
 
 DESCRIPTION = (
     "Expand a batch spec (a base case spec plus sweeps over speed, temperature, load, supply "
@@ -24,29 +24,23 @@ DESCRIPTION = (
     "runs/NAME/results.csv, the regime map (runs/NAME/regime/) and the batch report. "
     "Re-running resumes: finished cases are kept, failed ones re-run only with "
     "--rerun-failed. Exit 1 if a case failed, 2 on bad input (nothing built).")
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value} (valid range >= 1)")
-    return value
+EXAMPLES = ("ehlfoam batch examples/batches/default.toml",
+            "ehlfoam batch examples/batches/default.toml --dry-run",
+            "ehlfoam batch examples/batches/regime.toml --out runs/regime --slurm "
+            "cores=16,memory=16GB,walltime=01:00:00,jobs=4")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    """The batch command's arguments (shared by the subcommand and the module's main)."""
+    """The batch command's arguments."""
     p.add_argument("spec", help="batch spec TOML (e.g. examples/batches/default.toml)")
     p.add_argument("--out", default=None,
                    help="batch folder (default: runs/STEM/ in the working directory for STEM.toml)")
     p.add_argument("--rerun-failed", action="store_true",
                    help="re-run failed cases (finished cases are never recomputed)")
     size = p.add_mutually_exclusive_group()
-    size.add_argument("--jobs", type=_positive_int, default=None,
+    size.add_argument("--jobs", type=positive_int, default=None,
                       help="cases at once on this machine (each uses run.n_procs cores)")
-    size.add_argument("--cores", type=_positive_int, default=None,
+    size.add_argument("--cores", type=positive_int, default=None,
                       help="CPU budget on this machine (default: all cores); cases at once = "
                            "cores // run.n_procs")
     dask = p.add_mutually_exclusive_group()
@@ -66,9 +60,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Register ``ehlfoam batch``."""
-    p = subparsers.add_parser(
-        "batch", help="run a batch of cases (sweeps, speed ramps) and map the flow regimes",
-        description=DESCRIPTION)
+    p = add_command(
+        subparsers, "batch",
+        help="run a batch of cases (sweeps, speed ramps) and map the flow regimes",
+        description=DESCRIPTION, examples=EXAMPLES)
     add_arguments(p)
     p.set_defaults(func=cmd_batch)
     return p
@@ -101,8 +96,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m ehlfoam.cli.batch SPEC [options]`` (the same as ``ehlfoam batch``)."""
-    parser = argparse.ArgumentParser(prog="ehlfoam batch", description=DESCRIPTION)
-    add_arguments(parser)
+    parser = add_parser(argparse.ArgumentParser(prog="ehlfoam").add_subparsers())
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:

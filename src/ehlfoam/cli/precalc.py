@@ -9,10 +9,12 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from typing import TYPE_CHECKING
 
-from ehlfoam.errors import SpecError
+from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, add_command
 
-from ehlfoam.contact.spec import PrecalcSpec, load_spec, make_spec, valid_range
+if TYPE_CHECKING:
+    from ehlfoam.contact.spec import PrecalcSpec
 
 _OPTIONS = {
     # flag: (spec key, type, help with units)
@@ -33,21 +35,28 @@ _OPTIONS = {
 }
 
 
-def add_parser(subparsers) -> None:
+def add_parser(subparsers) -> argparse.ArgumentParser:
     """Register the ``precalc`` subcommand."""
-    p = subparsers.add_parser(
-        "precalc", help="solve the EHL contact (gap and film) of one operating point",
+    p = add_command(
+        subparsers, "precalc", help="solve the EHL contact (gap and film) of one operating point",
         description="Solve the isothermal EHL point contact (Reynolds + elastic deformation + "
                     "load balance) and write DIR/summary.json (SI units), DIR/solution.npz and "
-                    "DIR/precalc.png.")
+                    "DIR/precalc.png. Exit 1 if not converged (outputs written), 2 on bad "
+                    "input (nothing written).",
+        examples=["ehlfoam precalc --load 20 --speed 0.008 --temperature 40 --out precalc/u8",
+                  "ehlfoam precalc --speed 0.5 --grid 129 --out precalc/fast"])
     p.add_argument("spec_file", nargs="?", help="TOML spec (keys as the options, without --)")
-    for flag, (_, typ, help_) in _OPTIONS.items():
-        p.add_argument(flag, type=str if typ is not str else str, default=None, help=help_)
+    for flag, (_, _, help_) in _OPTIONS.items():
+        p.add_argument(flag, default=None, help=help_)   # converted by spec_from_args
     p.add_argument("--out", required=True, help="output folder")
     p.set_defaults(func=run)
+    return p
 
 
 def _convert(flag: str, raw: str | None):
+    from ehlfoam.contact.spec import valid_range
+    from ehlfoam.errors import SpecError
+
     if raw is None:
         return None
     key, typ, _ = _OPTIONS[flag]
@@ -61,6 +70,9 @@ def _convert(flag: str, raw: str | None):
 
 
 def spec_from_args(args: argparse.Namespace) -> PrecalcSpec:
+    """The contact spec of the options (over the TOML spec file, if given)."""
+    from ehlfoam.contact.spec import load_spec, make_spec
+
     values = {_OPTIONS[f][0]: _convert(f, getattr(args, f[2:].replace("-", "_")))
               for f in _OPTIONS}
     if args.spec_file:
@@ -69,11 +81,14 @@ def spec_from_args(args: argparse.Namespace) -> PrecalcSpec:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Solve, write the outputs, print the summary's main numbers as one JSON line."""
+    from ehlfoam.errors import SpecError
+
     try:
         spec = spec_from_args(args)
     except SpecError as err:
         print(f"ehlfoam precalc: {err}", file=sys.stderr)
-        return 2
+        return EXIT_BAD_INPUT
     from ehlfoam.contact.outputs import write_all
     from ehlfoam.contact.solver import solve
 
@@ -84,5 +99,5 @@ def run(args: argparse.Namespace) -> int:
     print(json.dumps({k: summary[k] for k in keys}))
     if not result.converged:
         print(f"ehlfoam precalc: NOT converged: {result.mg.failure}", file=sys.stderr)
-        return 1
-    return 0
+        return EXIT_FAILURE
+    return EXIT_OK

@@ -320,6 +320,8 @@ def read_metrics(case: str | os.PathLike) -> MetricsRecord:
     path = _metrics_path(case)
     try:
         data = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{path}: no such file (has the case run?)") from None
     except json.JSONDecodeError as err:
         raise ValueError(f"{path}: not JSON ({err})") from None
     if not isinstance(data, dict):

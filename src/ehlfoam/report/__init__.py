@@ -4,7 +4,8 @@
     report_batch(batch_dir) -> BATCH/report/index.html
     after_batch(batch_dir, log) -> the regime map's lines in the log, then report_batch
     report(dir)            -> whichever ``dir`` is
-    add_parser(subparsers) -> registers ``ehlfoam report DIR``
+
+``ehlfoam report DIR`` (ehlfoam.cli.report) is its command line.
 
 Everything renders off-screen (pyvista reads the case with its OpenFOAM reader and cuts
 it; matplotlib's Agg canvas draws): no X server, no ParaView.
@@ -17,8 +18,7 @@ from pathlib import Path
 
 from ehlfoam.report.case_report import report_case
 
-__all__ = ["add_parser", "after_batch", "is_batch", "is_case", "report", "report_batch",
-           "report_case"]
+__all__ = ["after_batch", "is_batch", "is_case", "report", "report_batch", "report_case"]
 
 
 def is_case(path: str | os.PathLike) -> bool:
@@ -62,9 +62,3 @@ def report(path: str | os.PathLike, **kwargs) -> Path:
     raise ValueError(f"{p}: neither a case (ehlfoam/geometry.json, system/controlDict) nor "
                      f"a batch (plan.json, results.csv, cases/)")
 
-
-def add_parser(subparsers):
-    """Register ``report`` on an argparse subparsers object (see runs/cli.py)."""
-    from ehlfoam.report.cli import add_parser as _add
-
-    return _add(subparsers)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ehlfoam.case.geometry import CaseGeometry, mesh_warnings
+from ehlfoam.notices import to_text
 from ehlfoam.metrics.record import MetricsRecord
 from ehlfoam.run import fields as case_fields
 from ehlfoam.run.balance import dissolved_air_budget, mass_balance
@@ -87,7 +88,7 @@ def final_record(case: Path, spec: CaseSpec, geom: CaseGeometry,
         "ball_wall_steps": geom.ball_wall_steps,
         "rear_meniscus_cell_over_a": rear_cell,
         "front_contact_line_cells_over_wall_cell": front_cells,
-        "warnings": "; ".join(
+        "warnings": to_text(
             mesh_warnings(geom) + rear_cell_warnings(rear_cell)
             + front_cell_warnings(front_cells, spec.physics.isotropic_compression)
             + (boundary_warnings(off_outlet, pattern) if surrounded else [])),

@@ -10,6 +10,7 @@ import numpy as np
 
 from ehlfoam.case.geometry import CaseGeometry
 from ehlfoam.mesh import size_function
+from ehlfoam.notices import Notice
 from ehlfoam.run import fields as case_fields
 from ehlfoam.spec.case import CaseSpec
 
@@ -45,23 +46,26 @@ _BOUNDARY_KEY = {"upstream": "domain.upstream", "outlet": "domain.downstream",
                  "side": "domain.side"}
 
 
-def boundary_warnings(off_outlet: float | None, pattern: dict | None = None) -> list[str]:
+def boundary_warnings(off_outlet: float | None, pattern: dict | None = None) -> list[Notice]:
     """Warnings when more than :data:`OFF_OUTLET_WARNING` of the oil leaving the domain
     (``off_outlet``, the share at the last write) did not leave through the outlet, and when
     the flooded region of the last write (``pattern``: its ``flooded_clearance_over_a`` and
     ``flooded_nearest_boundary``) is within :data:`CLEARANCE_WARNING` of an open boundary."""
     out = []
     if off_outlet is not None and off_outlet > OFF_OUTLET_WARNING:
-        out.append(f"{off_outlet:.0%} of the outflow left through the side or upstream boundary "
-                   f"(above {OFF_OUTLET_WARNING:.0%}): the flooded region or a wall film reached "
-                   f"it, so the region is cut short; widen the domain (domain.side, "
-                   f"domain.upstream)")
+        out.append(Notice(
+            "outflow-off-outlet",
+            f"{off_outlet:.0%} of the outflow left through the side or upstream boundary (above "
+            f"{OFF_OUTLET_WARNING:.0%}): the region is cut short, widen the domain (domain.side, "
+            f"domain.upstream)", "docs/models/domain.md#open-boundaries"))
     clearance = (pattern or {}).get("flooded_clearance_over_a")
     if clearance is not None and clearance < CLEARANCE_WARNING:
         where = pattern["flooded_nearest_boundary"]
-        out.append(f"the flooded region is {clearance:.2f} a from the {where} boundary (below "
-                   f"{CLEARANCE_WARNING:g} a): the boundary may hold or cut it; move it out "
-                   f"({_BOUNDARY_KEY[where]})")
+        out.append(Notice(
+            "region-near-boundary",
+            f"the flooded region is {clearance:.2f} a from the {where} boundary (below "
+            f"{CLEARANCE_WARNING:g} a): the boundary may hold or cut it, move it out "
+            f"({_BOUNDARY_KEY[where]})", "docs/models/domain.md#open-boundaries"))
     return out
 
 
@@ -76,19 +80,16 @@ def rear_meniscus_cell(spec: CaseSpec, pattern: dict | None) -> float | None:
     return float(size_function(spec)(x_rear * spec.a, 0.0) / spec.a)
 
 
-def rear_cell_warnings(rear_cell: float | None) -> list[str]:
+def rear_cell_warnings(rear_cell: float | None) -> list[Notice]:
     """A warning when the rear meniscus sits in cells (``rear_cell``, units a) coarser than
     :data:`REAR_CELL_WARNING`, naming what refines them."""
     if rear_cell is None or rear_cell <= REAR_CELL_WARNING:
         return []
-    return [f"the rear meniscus sits in {rear_cell:.2f} a cells (above {REAR_CELL_WARNING:g} a): "
-            f"they lay wall films thicker than Landau-Levich's and set how much oil leaves the "
-            f"region (0.7 -> 0.06 a there halved the coarse level's outflow), so the oil it holds "
-            f"and its width are off (the default levels' width by 11-20 % against the finest "
-            f"runs); refine over the rear (mesh.refine: a box as in runs/nominal_films.toml, or "
-            f"a band along this run's meniscus from `ehlfoam band CASE`); "
-            f"docs/cases.md, \"One step finer at the rear meniscus\", \"The oil goes to the "
-            f"rear meniscus\""]
+    return [Notice("rear-meniscus-cells",
+                   f"the rear meniscus sits in {rear_cell:.2f} a cells (above "
+                   f"{REAR_CELL_WARNING:g} a): its films, the oil held and the width are off, "
+                   f"refine there (mesh.refine as in nominal_films.toml)",
+                   "docs/models/interface.md#rear-meniscus")]
 
 
 def front_contact_line_cells(spec: CaseSpec, geom: CaseGeometry,
@@ -110,7 +111,7 @@ def front_contact_line_cells(spec: CaseSpec, geom: CaseGeometry,
 
 
 def front_cell_warnings(front_cells: float | None,
-                        isotropic_compression: float = 0.0) -> list[str]:
+                        isotropic_compression: float = 0.0) -> list[Notice]:
     """A warning when the region's front off the track, where dry walls run into it, sits in
     cells wider than :data:`FRONT_CELL_WARNING` wall cells; none with the compression taken
     from the local speed (``physics.isotropic_compression = 1``), with which the advancing
@@ -118,16 +119,8 @@ def front_cell_warnings(front_cells: float | None,
     compression")."""
     if front_cells is None or front_cells <= FRONT_CELL_WARNING or isotropic_compression == 1.0:
         return []
-    return [f"the flooded region's front off the track, where dry walls run into it, sits in "
-            f"in-plane cells {front_cells:.0f} times its wall cells (above "
-            f"{FRONT_CELL_WARNING:g}): there interFoam gives the advancing contact line no "
-            f"capillary suction, and neither the flooded width nor the inlet meniscus is "
-            f"converged (on the coarse walls resolving it moved the inlet meniscus 12 % "
-            f"downstream); take the interface compression from the local speed "
-            f"(physics.isotropic_compression = 1), with which the line holds on any cells and "
-            f"does not move with them (at some 30 deg, whatever the walls' angle; not for "
-            f"resting menisci), or continue the run on a mesh with a band along its "
-            f"meniscus (`ehlfoam band CASE --size S --half-width 1` into mesh.refine, S within "
-            f"{FRONT_CELL_WARNING:g} wall cells); docs/cases.md, \"The advancing contact "
-            f"line and the interface compression\", \"The region's sides are moving contact "
-            f"lines\""]
+    return [Notice("front-contact-line-cells",
+                   f"the front where dry walls run into it sits in cells {front_cells:.0f} wall "
+                   f"cells wide (above {FRONT_CELL_WARNING:g}): width and inlet meniscus "
+                   f"unconverged, physics.isotropic_compression = 1",
+                   "docs/models/interface.md#advancing-contact-line")]

@@ -18,8 +18,6 @@ prints the bands as TOML inline tables, ready for ``--set 'mesh.refine=[...]'`` 
 
 from __future__ import annotations
 
-import argparse
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -118,50 +116,3 @@ def bands_toml(bands: list[RefineBand]) -> str:
         return f"{{half_width={b.half_width:g},size={b.size:g},points=[{pts}]}}"
     return "[" + ",\n".join(one(b) for b in bands) + "]"
 
-
-def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("band", help="bands of finer cells along a run's meniscus (mesh.refine)",
-                       description=__doc__.split("\n\n")[0])
-    p.add_argument("case", type=Path)
-    p.add_argument("--size", type=float, required=True, help="cell size in the band [a]")
-    p.add_argument("--half-width", type=float, required=True,
-                   help="the band reaches this far either side of the meniscus [a]")
-    p.add_argument("--time", default="last",
-                   help="transits of the write to read, 'last', or 'start' (the initial field: "
-                        "a case started from a thin-film state has its meniscus there)")
-    p.add_argument("--spacing", type=float, default=None,
-                   help="distance between the band's points [a] (default half-width / 4)")
-    p.add_argument("--min-length", type=float, default=None,
-                   help="leave out meniscus lines shorter than this [a] (default half-width)")
-    p.set_defaults(func=cmd_band)
-
-
-def _check_args(args: argparse.Namespace) -> None:
-    """Bad numbers fail before the case is read, naming the option and its range."""
-    for name, value, hi in (("--size", args.size, 10.0), ("--half-width", args.half_width, 20.0),
-                            ("--spacing", args.spacing, 20.0)):
-        if value is not None and not 0.0 < value <= hi:
-            raise ValueError(f"{name} = {value:g} a is out of range (0 < {name} <= {hi:g} a)")
-    if args.min_length is not None and not 0.0 <= args.min_length <= 1e3:
-        raise ValueError(f"--min-length = {args.min_length:g} a is out of range "
-                         "(0 <= --min-length <= 1000 a)")
-
-
-def cmd_band(args: argparse.Namespace) -> int:
-    try:
-        _check_args(args)
-        time, lines = meniscus_lines(args.case, args.time)
-    except (ValueError, FileNotFoundError) as err:
-        print(f"ehlfoam band: {err}", file=sys.stderr)
-        return 2
-    bands = meniscus_bands(lines, args.size, args.half_width, args.spacing, args.min_length)
-    if not bands:
-        shortest = args.half_width if args.min_length is None else args.min_length
-        print(f"ehlfoam band: {args.case} has no meniscus line of {shortest:g} a or longer "
-              f"at t = {time:g} s",
-              file=sys.stderr)
-        return 1
-    print(bands_toml(bands))
-    print(f"# {len(bands)} band(s) along the meniscus of {args.case} at t = {time:g} s, "
-          f"{sum(len(b.points) for b in bands)} points", file=sys.stderr)
-    return 0

@@ -21,10 +21,8 @@ A snapshot of a 66,060-cell case (20 layers) takes 0.51 MB, 0.14 MB with alpha.o
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
-import sys
 from pathlib import Path
 from typing import Any, Iterable
 
@@ -239,28 +237,3 @@ def snapshot_history_of(record: dict[str, Any]) -> tuple[dict[str, np.ndarray], 
     keep = columns["time_s"] <= record["time_s"] * (1.0 + 1e-9)
     return {k: v[keep] for k, v in columns.items()}, record["time_s"] / record["transits"]
 
-
-def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("snapshot", help="a run case's state in one small file (--start-from)",
-                       description=__doc__.split("\n\n")[0])
-    p.add_argument("case", type=Path)
-    p.add_argument("out", type=Path, help="the snapshot file to write (.npz)")
-    p.add_argument("--time", default="last",
-                   help="transits of the write to keep, or 'last' (default)")
-    p.add_argument("--fields", nargs="+", default=list(FIELDS), choices=FIELDS,
-                   help="fields to keep (alpha.oil always; U makes the file some 4 times "
-                        "larger and the first steps calmer)")
-    p.set_defaults(func=cmd_snapshot)
-
-
-def cmd_snapshot(args: argparse.Namespace) -> int:
-    try:
-        record = save_snapshot(args.case, args.out, args.time, tuple(args.fields))
-    except (SnapshotError, ValueError, OSError) as err:
-        print(f"ehlfoam snapshot: {err}", file=sys.stderr)
-        return 2
-    size = args.out.stat().st_size
-    print(f"snapshot {args.out}: {record['source']} at t = {record['time_s']:.6g} s "
-          f"({record['transits']:.4f} transits), {record['cells']} cells, "
-          f"{', '.join(record['fields'])}, {size / 1e6:.2f} MB")
-    return 0

@@ -1,0 +1,133 @@
+"""``ehlfoam case``: write an OpenFOAM case from a TOML case spec.
+
+Exit codes: 0 written, 2 bad input (a bad spec or --set, an existing folder, a --start-from
+that does not fit; nothing left written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+from collections.abc import Iterable
+from typing import Any
+
+from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_OK, add_command, print_notices
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Register ``ehlfoam case``."""
+    p = add_command(
+        subparsers, "case", help="write an OpenFOAM case from a case spec (TOML)",
+        description="Validate the case spec, solve (or reuse) its EHL precalc, mesh the gap "
+                    "around the contact and write a complete OpenFOAM case that also runs by "
+                    "hand (DIR/Allrun). Exit 2 on a bad spec, before anything is written.",
+        examples=["ehlfoam case examples/cases/nominal.toml --out runs/nominal "
+                  "--set mesh.resolution=coarse",
+                  "ehlfoam case examples/cases/nominal.toml --out runs/u17 "
+                  "--set contact.speed=0.017 --start-from runs/nominal"])
+    p.add_argument("spec", nargs="?", help="case spec TOML (default: the reference case)")
+    p.add_argument("--out", required=True, help="case folder to write")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE",
+                   help="override a spec value, e.g. --set contact.speed=0.017 "
+                        "--set mesh.resolution=coarse; none clears an optional key, e.g. "
+                        "--set mesh.polar_radius=none (repeatable)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing case")
+    p.add_argument("--start-from", default=None, metavar="CASE|SNAPSHOT.npz|STATE.npz",
+                   help="start from the final fields of another run case (a converged "
+                        "neighbour: another speed, supply or level), copied on the same "
+                        "mesh, else interpolated; from a case snapshot (`ehlfoam "
+                        "snapshot`); or from the oil of a thin-film state "
+                        "(ehlfoam.thinfilm.state). With mesh.follow the mesh follows its "
+                        "meniscus (needed then)")
+    p.set_defaults(func=cmd_case)
+    return p
+
+
+def parse_value(text: str) -> Any:
+    """A --set value: TOML scalar syntax (numbers, booleans, quoted or bare strings), or
+    ``none`` for an optional key's "not set" (e.g. ``mesh.polar_radius=none``: free quads)."""
+    import tomllib
+
+    if text.strip().lower() == "none":
+        return None
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def parse_overrides(items: Iterable[str] | None) -> dict[str, Any]:
+    """``KEY=VALUE`` options as the spec's dotted-key overrides. Raises ValueError for an
+    item without '='."""
+    out = {}
+    for item in items or []:
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            raise ValueError(f"--set {item!r}: expected KEY=VALUE, e.g. contact.speed=0.017")
+        out[key] = parse_value(value)
+    return out
+
+
+def cmd_case(args: argparse.Namespace) -> int:
+    """Validate the spec, then build the case (precalc, mesh, OpenFOAM files)."""
+    from ehlfoam.errors import SpecError
+    from ehlfoam.spec.case import load_case_spec, make_case_spec
+
+    try:
+        overrides = parse_overrides(args.set)
+        spec = (load_case_spec(args.spec, **overrides) if args.spec
+                else make_case_spec(None, **overrides))
+    except (SpecError, ValueError) as err:
+        return _bad(err)
+    if spec.mesh.follow is not None and not args.start_from:
+        return _bad("mesh.follow needs --start-from (a run case, a case snapshot or a "
+                    "thin-film state): the mesh follows that state's meniscus")
+    if args.start_from:
+        from ehlfoam.seed.start import RampError, check_start
+
+        try:   # before anything is written
+            check_start(args.start_from)
+        except (RampError, OSError) as err:   # missing, or not a folder
+            return _bad(f"--start-from {args.start_from}: {err}")
+    return _write(spec, args)
+
+
+def _write(spec, args: argparse.Namespace) -> int:
+    from ehlfoam.case.geometry import mesh_warnings
+    from ehlfoam.case.writer import CaseExists
+    from ehlfoam.seed.follow import write_started_case
+    from ehlfoam.seed.mapping import oil_carried
+    from ehlfoam.seed.start import RampError
+
+    try:
+        geom, seed = write_started_case(spec, args.out, args.start_from,
+                                        overwrite=args.overwrite)
+    except CaseExists as err:
+        return _bad(err)
+    except RampError as err:   # found only on the new mesh: leave no half-made case
+        shutil.rmtree(args.out, ignore_errors=True)
+        return _bad(f"--start-from {args.start_from}: {err}")
+    except ValueError as err:   # mesh.follow: the source has no meniscus to follow
+        if spec.mesh.follow is None:
+            raise
+        shutil.rmtree(args.out, ignore_errors=True)
+        return _bad(f"--start-from {args.start_from}: {err}")
+    if seed is not None:
+        at = ("" if seed["previous_time_s"] is None
+              else f" at t = {seed['previous_time_s']:.4g} s")
+        print(f"starts from {args.start_from}{at} ({seed['method']}: "
+              f"{', '.join(seed['fields'])})")
+        if seed.get("oil"):
+            print(oil_carried(seed["oil"]))
+    print(f"case {args.out}: {geom.solver}, {geom.cells} cells, a = {geom.a * 1e3:.4f} mm, "
+          f"transit {geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, "
+          f"maxDeltaT {geom.max_delta_t:.3g} s ({geom.capillary_limit}), "
+          f"gap mismatch {geom.gap_mismatch:.2%}, ball wall steps {geom.ball_wall_steps:.1f}")
+    print_notices("case", mesh_warnings(geom))
+    return EXIT_OK
+
+
+def _bad(err: object) -> int:
+    print(f"ehlfoam case: {err}", file=sys.stderr)
+    return EXIT_BAD_INPUT
