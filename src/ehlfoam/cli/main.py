@@ -29,6 +29,7 @@ from collections.abc import Sequence
 
 from ehlfoam.cli import precalc as precalc_cli
 from ehlfoam.cli import batch as batch_cli
+from ehlfoam.cli import thin_film as thin_film_cli
 from ehlfoam.seed import snapshot as case_snapshot
 from ehlfoam.seed import band as meniscus_band
 from ehlfoam.seed.mapping import oil_carried
@@ -222,7 +223,7 @@ def build_parser() -> argparse.ArgumentParser:
                            "neighbour: another speed, supply or level), copied on the same "
                            "mesh, else interpolated; from a case snapshot (`ehlfoam "
                            "snapshot`); or from the oil of a thin-film state "
-                           "(bench/thin_film_region.py writes them). With mesh.follow the "
+                           "(`ehlfoam thin-film` writes them). With mesh.follow the "
                            "mesh follows its meniscus (needed then)")
     case.set_defaults(func=cmd_case)
 
@@ -245,6 +246,7 @@ def build_parser() -> argparse.ArgumentParser:
     case_snapshot.add_parser(sub)
     _report_add_parser(sub)
     batch_cli.add_parser(sub)
+    thin_film_cli.add_parser(sub)
     return parser
 
 
