@@ -18,12 +18,15 @@ def run_bench(name: str, tmp_path: Path, *args: str) -> tuple[str, dict]:
     """Run ``bench/NAME.py --quick --out TMP/NAME.json ARGS`` from the repository root: its
     stdout and its record. Asserts it wrote nothing but the record (into tmp_path) and
     nothing into bench/."""
-    before = sorted(p.name for p in (ROOT / "bench").iterdir())
+    def listing() -> list[str]:
+        return sorted(p.name for p in (ROOT / "bench").iterdir() if p.name != "__pycache__")
+
+    before = listing()
     out = tmp_path / f"{name}.json"
     proc = subprocess.run([sys.executable, f"bench/{name}.py", "--quick", "--out", str(out),
                            *args], cwd=ROOT, capture_output=True, text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
-    assert sorted(p.name for p in (ROOT / "bench").iterdir()) == before
+    assert listing() == before
     assert [p.name for p in tmp_path.iterdir()] == [out.name]
     assert f"wrote {out}" in proc.stdout
     return proc.stdout, json.loads(out.read_text())
