@@ -258,7 +258,7 @@ class Ramp(BaseModel):
         start_from: a run case folder (absolute, or relative to where the batch is started)
             whose final fields the first step starts from: a converged state to step the
             speed up from, instead of the standard start (the puddle); or a thin-film state
-            (.npz, ``bench/thin_film_region.py``) whose oil it starts from.
+            (.npz, ``ehlfoam thin-film``) whose oil it starts from.
     """
 
     model_config = _STRICT

@@ -4,7 +4,7 @@ The least model of the oil around the contact: the gap-averaged (Reynolds) flow 
 between two walls rolling at (u, 0), held by a meniscus whose capillary pressure is
 Young-Laplace's across the gap, fed and drained only by the oil layers the walls carry. It
 answers in seconds to minutes where the 3D interface cases take hours, on cells of any size,
-so its flooded width can be converged on its own grid (``bench/thin_film_region.py``).
+so its flooded width can be converged on its own grid (``ehlfoam thin-film``).
 
 On a uniform grid of square cells over the half domain y >= 0 (symmetry on y = 0), each cell
 holds oil c [m] per unit area, 0 <= c <= h. A full cell (c = h) is **flooded**: its pressure p
@@ -119,7 +119,7 @@ class ThinFilmProblem:
             inward normal, from the region smoothed over ``normal_length``). In a strip of
             interFoam with dry walls advancing at the nominal Ca = 0.0058 the meniscus
             settles at 44-51 deg on in-plane cells within some 15 wall cells, and holds no
-            suction at all on coarser ones (``bench/contact_line_strip.py``).
+            suction at all on coarser ones (:mod:`ehlfoam.case.strip`).
         meniscus_position: where a meniscus sits in the open cell beside a flooded one:
             "sub-cell", as far into it as the cell's bulk oil fills it (its oil beyond the
             layers or films the walls carry, over the rest of its gap), so that the
