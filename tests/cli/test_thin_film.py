@@ -52,3 +52,15 @@ def test_bad_input_is_refused_by_name_value_and_range(tmp_path, capsys, args, wo
     assert main(["thin-film", "--out", str(out), *args, "--quiet"]) == 2
     assert words in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_balance_marches_until_the_outflow_meets_the_supply(tmp_path, capsys):
+    """--balance without --transits: up to 200 transits, stopping at the balance."""
+    out = tmp_path / "tf"
+    assert main(["thin-film", "--out", str(out), *SMALL_SET, "--cell", "0.5", "--balance",
+                 "--tolerance", "0.05", "--window", "3", "--quiet"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["balance"] and summary["transits_max"] == 200.0
+    assert summary["metrics"]["steady"] and summary["transits"] < 200
+    assert summary["metrics"]["outflow_over_supply"] == pytest.approx(1.0, abs=0.1)
+    assert ", balanced (outflow / supply" in capsys.readouterr().out

@@ -68,8 +68,9 @@ def add_parser(subparsers: Any) -> None:
                    help="folder to write state.npz and summary.json into")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a spec value, as `ehlfoam case --set` (repeatable)")
-    p.add_argument("--transits", type=_ranged(float, 0.0, 1e4), default=10.0,
-                   help="transits to march (with --balance: at most) (default: 10)")
+    p.add_argument("--transits", type=_ranged(float, 0.0, 1e4), default=None,
+                   help="transits to march (default: 10); with --balance, the most to march "
+                        "(default: 200)")
     p.add_argument("--balance", action="store_true",
                    help="stop when the outflow balances the supply and the oil stands")
     p.add_argument("--tolerance", type=_ranged(float, 0.0, 1.0, hi_open=True), default=0.01,
@@ -128,12 +129,13 @@ def cmd_thin_film(args: argparse.Namespace) -> int:
         prob = problem_from_spec(spec, gap, options)
     except ValueError as err:
         return bad(str(err))
+    transits = args.transits or (200.0 if args.balance else 10.0)
     t0 = time.perf_counter()
-    sol = march(spec, prob, transits=args.transits, balance=args.balance,
+    sol = march(spec, prob, transits=transits, balance=args.balance,
                 tolerance=args.tolerance, window=args.window, courant=args.courant,
                 start=start, progress=None if args.quiet else _progress(spec))
     record = {"spec": args.spec, "set": overrides, "options": asdict(options),
-              "transits_max": args.transits, "balance": args.balance,
+              "transits_max": transits, "balance": args.balance,
               "tolerance": args.tolerance if args.balance else None,
               "window": args.window if args.balance else None, "courant": args.courant,
               "start": None if args.start is None else str(args.start),
