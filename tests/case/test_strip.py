@@ -14,14 +14,12 @@ from ehlfoam.gap.source import load_gap
 from ehlfoam.metrics.strip import columns, film_history
 from ehlfoam.run.fields import time_folders
 from ehlfoam.spec.case import make_case_spec
-from tests.tiny import SMALL
+from tests.tiny import SMALL, small_contact
 
 
 @pytest.fixture(scope="module")
 def small():
-    spec = make_case_spec(SMALL)
-    gap, _ = load_gap(spec.contact)
-    return spec, gap, spec.a
+    return small_contact()
 
 
 def _run(case):

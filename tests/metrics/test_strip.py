@@ -10,17 +10,13 @@ import pytest
 from foamlib import FoamFieldFile
 
 from ehlfoam.case.strip import strip_mesh, write_strip_case
-from ehlfoam.gap.source import load_gap
 from ehlfoam.metrics.strip import columns, rear_films, wall_rows
-from ehlfoam.spec.case import make_case_spec
-from tests.tiny import SMALL
+from tests.tiny import small_contact
 
 
 @pytest.fixture(scope="module")
 def strip():
-    spec = make_case_spec(SMALL)
-    gap, _ = load_gap(spec.contact)
-    a = spec.a
+    spec, gap, a = small_contact()
     return spec, gap, a, strip_mesh(spec, gap, 4 * a, 10 * a, 0.5 * a)
 
 

@@ -6,18 +6,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ehlfoam.gap.source import load_gap
 from ehlfoam.spec.case import make_case_spec
 from ehlfoam.thinfilm.bridge import (angle_at_meniscus, bridge_balance, cox_voinov,
                                      meniscus_for_angle, x_at_gap)
-from tests.tiny import SMALL
+from tests.tiny import SMALL, small_contact
 
 
 @pytest.fixture(scope="module")
 def small():
-    spec = make_case_spec(SMALL)
-    gap, _ = load_gap(spec.contact)
-    return spec, gap, spec.a
+    return small_contact()
 
 
 def test_the_meniscus_position_and_its_apparent_angle_invert_each_other(small):
