@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import json
 import multiprocessing as mp
 import re
 import resource
@@ -134,8 +133,3 @@ def solver_cpu_s(case: Path) -> float | None:
                        re.M)
     return float(times[-1]) if times else None
 
-
-def jsonable(data: Any) -> Any:
-    """``data`` with tuples as lists and numpy scalars as Python numbers (for --out)."""
-    return json.loads(json.dumps(data, default=lambda v: v.item() if hasattr(v, "item")
-                                 else str(v)))

@@ -103,7 +103,8 @@ def cmd_thin_film(args: argparse.Namespace) -> int:
     from ehlfoam.errors import SpecError
     from ehlfoam.gap.source import load_gap
     from ehlfoam.spec.case import load_case_spec, make_case_spec
-    from ehlfoam.thinfilm.from_spec import RegionOptions, march, problem_from_spec, write_region
+    from ehlfoam.thinfilm.from_spec import (STATE_FILE, SUMMARY_FILE, RegionOptions, march,
+                                            problem_from_spec, write_region)
     from ehlfoam.thinfilm.state import load_state
 
     def bad(message: str) -> int:
@@ -142,7 +143,7 @@ def cmd_thin_film(args: argparse.Namespace) -> int:
               "wall_s": time.perf_counter() - t0}
     summary = write_region(sol, spec, args.out, record)
     print(_metrics_text(summary), flush=True)
-    print(f"wrote {args.out / 'state.npz'} and {args.out / 'summary.json'}")
+    print(f"wrote {args.out / STATE_FILE} and {args.out / SUMMARY_FILE}")
     return 0
 
 
