@@ -27,3 +27,13 @@ def tiny_geometry(**kw) -> CaseGeometry:
                 gap_mismatch=0.0, oil_viscosity=0.02, oil_density=870.0,
                 solver="interPhaseChangeFoam")
     return CaseGeometry(**(base | kw))
+
+
+def small_contact():
+    """The tiny case's spec, its gap h(x, y) [m] and its Hertzian radius a [m] (the precalc
+    solved once per machine, then reused)."""
+    from ehlfoam.gap.source import load_gap
+    from ehlfoam.spec.case import make_case_spec
+
+    spec = make_case_spec(SMALL)
+    return spec, load_gap(spec.contact)[0], spec.a

@@ -101,7 +101,7 @@ def test_case_report_has_every_part(case_report, finished_case):
     assert "<td>nl</td>" in html and "<td>mm/s</td>" in html
     assert f"{metrics['cells']:,}" in html
     assert "interFoam" in html and "OPENFOAM=" in html            # solver and build
-    # (its cost is measured by bench/report_bench.py, not asserted here)
+    # (its cost is timed elsewhere, not asserted here)
 
 
 def test_top_view_meniscus_lies_where_the_metrics_say(case_report, finished_case):

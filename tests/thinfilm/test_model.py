@@ -278,38 +278,8 @@ def test_bad_parameters_are_refused_by_name_and_range(key, value, words):
         ball_problem(**{key: value})
 
 
-def test_a_case_spec_becomes_the_same_problem():
-    """bench/thin_film_region.py reads the spec's contact, oil, wetting and supply."""
-    from bench.thin_film_region import problem_from_spec
-    from ehlfoam.spec.case import make_case_spec
-
-    spec = make_case_spec({"supply": {"mode": "layers", "disc_layer": 5e-6, "ball_layer": 3e-6,
-                                      "track_half_width": 2e-4, "initial_puddle": 6.0},
-                           "physics": {"contact_angle": 20.0}})
-    a = spec.a
-    prob = problem_from_spec(spec, ball_gap, 0.25, (-10.0, 18.0, 9.0), film_factor=2.0,
-                             receding="bretherton", normal_length=0.3)
-    assert prob.supply == pytest.approx(8e-6)
-    assert prob.track_half_width == pytest.approx(2e-4)
-    assert prob.initial_radius == pytest.approx(6 * a)
-    assert prob.island_radius == pytest.approx(spec.domain.island_radius * a)
-    assert prob.x_range == pytest.approx((-10 * a, 18 * a)) and prob.y_max == pytest.approx(9 * a)
-    assert prob.cell == pytest.approx(0.25 * a)
-    assert (prob.speed, prob.viscosity) == (spec.speed, spec.oil_viscosity)
-    assert (prob.contact_angle, prob.receding_meniscus) == (20.0, "bretherton")
-    assert prob.normal_length == pytest.approx(0.3 * a)
-    assert prob.film == pytest.approx(2 * landau_levich(spec.oil_viscosity, spec.speed,
-                                                        spec.physics.surface_tension))
-    flooded = make_case_spec({"supply": {"mode": "flooded"}})
-    prob = problem_from_spec(flooded, ball_gap, 0.25, (-10.0, 18.0, 9.0))
-    assert prob.supply == pytest.approx(ball_gap(-10 * flooded.a, 0.0))   # the whole inlet gap
-    with pytest.raises(ValueError, match="supply.mode = 'submerged'"):
-        problem_from_spec(make_case_spec({"supply": {"mode": "submerged"}}), ball_gap, 0.25,
-                          (-10.0, 18.0, 9.0))
-
-
 def test_a_saved_state_starts_a_run_where_it_left_off(tmp_path):
-    """bench/thin_film_region.py --start: a state written by a run, read back, starts the
+    """`ehlfoam thin-film --start`: a state written by a run, read back, starts the
     next one with the same oil in the same cells, on its grid or a finer one."""
     from ehlfoam.thinfilm.state import load_state, save_state
 
@@ -322,38 +292,6 @@ def test_a_saved_state_starts_a_run_where_it_left_off(tmp_path):
     finer = solve_thin_film(ball_problem(cell=0.2 * A), transits_max=0, start=start)
     assert finer.metrics(A)["oil_volume_m3"] == pytest.approx(sol.metrics(A)["oil_volume_m3"],
                                                               rel=0.05)
-
-
-def test_the_lateral_current_beside_the_rear_meniscus_is_read_off_the_pressure(tmp_path):
-    """bench/rear_currents.py on a thin-film state written by hand: a gap of 10 um, the region
-    flooded ahead of x = 8 a, a pressure falling along y at the rate that drives 0.3 u across
-    y (h^2 / (12 eta) dp/dy = -0.3 u). Beside the rear meniscus (x_r = 8 a) the gap-averaged
-    rms is 0.3 u over the flooded cells only, the Poiseuille profile's sqrt(6/5) times that;
-    a state without its pressure is refused by name."""
-    from bench.rear_currents import thin_film_currents
-    from ehlfoam.spec.case import make_case_spec
-
-    spec = make_case_spec({})
-    a, u, eta, gap = spec.a, spec.speed, spec.oil_viscosity, 10e-6
-    d = 0.25 * a
-    x = -4 * a + d * (np.arange(80) + 0.5)
-    y = d * (np.arange(24) + 0.5)
-    X, Y = np.meshgrid(x, y)
-    h = np.where(np.hypot(X, Y) < a, np.nan, gap)
-    flooded = (X < 8 * a) & ~np.isnan(h)
-    p = np.where(flooded, 0.3 * u * 12 * eta / gap**2 * (-Y), np.nan)
-    state = tmp_path / "state.npz"
-    np.savez(state, x=x, y=y, h=h, flooded=flooded, content=np.where(flooded, h, 0.0), p=p,
-             fill=np.zeros(h.shape))
-    res = thin_film_currents(state, spec, half_length=1.0, y_from=0.5, y_to=1.5)
-    assert res["rear_over_a"] == pytest.approx(8.0)
-    assert res["cells"] == 4 * 4                    # x in (7, 8) a, y in [0.5, 1.5) a
-    assert res["gap_averaged_rms_over_u"] == pytest.approx(0.3, rel=1e-9)
-    assert res["gap_averaged_median_abs_over_u"] == pytest.approx(0.3, rel=1e-9)
-    assert res["poiseuille_rms_over_u"] == pytest.approx(0.3 * np.sqrt(1.2), rel=1e-9)
-    np.savez(state, x=x, y=y, h=h, flooded=flooded, content=np.where(flooded, h, 0.0))
-    with pytest.raises(ValueError, match="holds no pressure"):
-        thin_film_currents(state, spec)
 
 
 def test_oil_fraction_at_reads_the_cell_holding_a_point_on_either_side_of_the_axis():

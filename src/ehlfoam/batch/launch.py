@@ -116,7 +116,7 @@ class BatchOptions:
     rerun_failed: bool = False
     scheduler: str | None = None       # Dask scheduler address
     slurm: dict[str, Any] | None = None
-    client: Any = None                 # an existing distributed.Client (tests, benchmarks)
+    client: Any = None                 # an existing distributed.Client (tests, timings)
     quiet: bool = False
     regime: bool = True                # the regime analysis (regime/regime.json)
     #: what reports the batch after its cases, called with the batch folder and the log

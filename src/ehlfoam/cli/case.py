@@ -38,7 +38,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         "neighbour: another speed, supply or level), copied on the same "
                         "mesh, else interpolated; from a case snapshot (`ehlfoam "
                         "snapshot`); or from the oil of a thin-film state "
-                        "(ehlfoam.thinfilm.state). With mesh.follow the mesh follows its "
+                        "(`ehlfoam thin-film` writes one). With mesh.follow the mesh follows its "
                         "meniscus (needed then)")
     p.set_defaults(func=cmd_case)
     return p

@@ -3,6 +3,7 @@
 Subcommands, one module each in :mod:`ehlfoam.cli`:
   doctor   show the OpenFOAM runtime and check its build (pitzDaily test)
   precalc  the EHL pre-calculation of one operating point
+  thin-film the gap-averaged model's balanced region, a state to start a case from
   case     write an OpenFOAM case from a TOML case spec
   run      run a case to steady state and write its metrics.json
   band     bands of finer cells along a run's meniscus (for mesh.refine)
@@ -23,11 +24,12 @@ import os
 import sys
 from collections.abc import Sequence
 
-from ehlfoam.cli import band, batch, case, doctor, foam, precalc, report, run, snapshot
+from ehlfoam.cli import (band, batch, case, doctor, foam, precalc, report, run, snapshot,
+                         thin_film)
 from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED
 
 #: the subcommands, in the order ``ehlfoam --help`` lists them
-COMMANDS = (doctor, precalc, case, run, band, snapshot, report, batch, foam)
+COMMANDS = (doctor, precalc, thin_film, case, run, band, snapshot, report, batch, foam)
 
 
 def version() -> str:

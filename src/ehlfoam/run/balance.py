@@ -35,7 +35,7 @@ OIL_FLUX_APPROXIMATE = (
     "phi x face alpha at the writes (the solver writes no alphaPhi0): approximate. It closes "
     "within 1 % while no interface crosses an open boundary (state I); with an open wake it "
     "misses part of the outflow whatever the write density (6 % of it on a 20 mm/s window "
-    "written every step; bench/balance_window.py, docs/cavitation.md)")
+    "written every step; docs/validation.md#v-mass-balance)")
 
 
 def mass_balance(history: list[Sample]) -> dict:

@@ -290,7 +290,7 @@ def advancing_front_cells(folder: Path, structure: Structure, geom: CaseGeometry
     (:func:`metrics.advancing_front` of the mid-gap oil at ``folder``): the in-plane size of
     the column there (the square root of its area) over its wall cell's height. A contact line
     advancing onto dry walls holds a capillary suction only where that is within some 15
-    (``bench/contact_line_strip.py``). Empty without such an edge."""
+    (the contact-line strip, :mod:`ehlfoam.case.strip`). Empty without such an edge."""
     r = mid_gap_raster(read_alpha(folder / "alpha.oil", structure), structure, geom)
     points = metrics.advancing_front(r, track_half_width)
     if not len(points):

@@ -35,7 +35,7 @@ def check_start(source: str | Path) -> None:
         load_state(source)
     except (OSError, KeyError, ValueError) as err:
         raise RampError(f"{source} is not a thin-film state written by "
-                        f"bench/thin_film_region.py ({err})") from None
+                        f"`ehlfoam thin-film` ({err})") from None
 
 
 def seed_case(case: str | Path, source: str | Path) -> dict[str, Any]:

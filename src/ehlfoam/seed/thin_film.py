@@ -2,7 +2,7 @@
 
 The thin-film model (:mod:`ehlfoam.thinfilm`) brings the nominal region to its
 balance in minutes on one core; a 3D case from the spec's puddle takes hours to get there on
-two. A state the model wrote (``bench/thin_film_region.py``, :mod:`ehlfoam.thinfilm.state`)
+two. A state the model wrote (``ehlfoam thin-film``, :mod:`ehlfoam.thinfilm.state`)
 gives the 3D case its oil instead: each column of cells is oil where the model's cell is
 flooded, and behind the menisci carries the model's films (its oil over the gap, c / h), half on
 each wall, as the spec's supply layers are laid. Columns off the model's grid keep the spec's

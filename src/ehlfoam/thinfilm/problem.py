@@ -61,7 +61,7 @@ class ThinFilmProblem:
             inward normal, from the region smoothed over ``normal_length``). In a strip of
             interFoam with dry walls advancing at the nominal Ca = 0.0058 the meniscus
             settles at 44-51 deg on in-plane cells within some 15 wall cells, and holds no
-            suction at all on coarser ones (``bench/contact_line_strip.py``).
+            suction at all on coarser ones (:mod:`ehlfoam.case.strip`).
         meniscus_position: where a meniscus sits in the open cell beside a flooded one:
             "sub-cell", as far into it as the cell's bulk oil fills it (its oil beyond the
             layers or films the walls carry, over the rest of its gap), so that the
