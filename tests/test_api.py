@@ -88,3 +88,12 @@ def test_bad_input_through_the_api(tmp_path):
     with pytest.raises(TypeError, match="nonsense"):
         ehlfoam.run_batch(spec, nonsense=1)
     assert not (tmp_path / "b").exists()
+
+
+def test_the_readme_shows_the_example_that_runs():
+    """The README's Python block is examples/api.py's code, so the example users read is the
+    one this file's first test runs."""
+    readme = (ROOT / "README.md").read_text()
+    block = readme.split("```python\n", 1)[1].split("```", 1)[0]
+    api = (ROOT / "examples" / "api.py").read_text()
+    assert block.strip() and block.strip() in api

@@ -9,6 +9,7 @@ from ehlfoam.case.geometry import BALL_WALL_STEPS_LIMIT, mesh_warnings
 from ehlfoam.notices import MAX_TEXT, Notice, NoticeTally, from_text, to_text
 from ehlfoam.run.monitor import (FRONT_CELL_WARNING, REAR_CELL_WARNING, boundary_warnings,
                                  front_cell_warnings, rear_cell_warnings)
+from tests.test_docs_links import ROOT, _anchors
 from tests.tiny import tiny_geometry
 
 REAR = Notice("rear-meniscus-cells", "the rear meniscus sits in 0.59 a cells (above 0.15 a)",
@@ -76,6 +77,9 @@ def test_every_warning_the_package_raises_is_a_notice_that_fits_at_extreme_value
                                         "front-contact-line-cells", "outflow-off-outlet",
                                         "region-near-boundary"]
     assert all(n.docs.startswith("docs/") for n in raised)
+    for n in raised:   # each pointer names a page and one of its sections
+        page, _, anchor = n.docs.partition("#")
+        assert (ROOT / page).is_file() and anchor in _anchors(ROOT / page), n.docs
     assert from_text(to_text(raised)) == raised
     # and none below their limits
     assert not mesh_warnings(tiny_geometry(ball_wall_steps=BALL_WALL_STEPS_LIMIT))

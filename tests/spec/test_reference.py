@@ -26,6 +26,7 @@ def _keys(model: type[BaseModel], where: str = "") -> list[str]:
     def walk(node: dict, prefix: str) -> list[str]:
         out = []
         for name, prop in node.get("properties", {}).items():
+            name = prop.get("key", name)   # a table of any case-spec keys names a placeholder
             key = f"{prefix}.{name}" if prefix else name
             out.append(key)
             refs = [r["$ref"] for r in _refs(prop)]

@@ -208,7 +208,8 @@ class Sweep(RootModel[dict[str, Values]]):
                     "list, a range {start, stop, num | step, spacing} or a single value; a "
                     "table sets its keys (supply = [{disc_layer = 1e-6, ball_layer = 1e-6}, "
                     "{mode = \"flooded\"}])",
-        json_schema_extra={"unit": "the case spec's unit of each key"})
+        json_schema_extra={"unit": "the case spec's unit of each key",
+                           "key": "<case-spec key>"})
 
     @model_validator(mode="before")
     @classmethod
@@ -240,7 +241,8 @@ class Ramp(BaseModel):
     fixed: dict[str, Any] = Field(
         {}, description="Other case-spec keys (dotted) at single values for every step "
                         "(default: the base's)",
-        json_schema_extra={"unit": "the case spec's unit of each key"})
+        json_schema_extra={"unit": "the case spec's unit of each key",
+                           "key": "<case-spec key>"})
 
     @model_validator(mode="before")
     @classmethod

@@ -91,7 +91,7 @@ def mesh_warnings(geom: CaseGeometry) -> list[Notice]:
                    f"the ball's wall cells step {geom.ball_wall_steps:.1f} heights per cell "
                    f"(above {BALL_WALL_STEPS_LIMIT:g}): a spurious oil film creeps along the "
                    f"ball, thin mesh.n_layers need finer in-plane cells",
-                   "docs/models/interface.md#warnings-a-run-gives")]
+                   "docs/models/interface.md#ball-wall-steps")]
 
 
 def load_geometry(case: str | os.PathLike) -> CaseGeometry:

@@ -57,7 +57,7 @@ def boundary_warnings(off_outlet: float | None, pattern: dict | None = None) -> 
             "outflow-off-outlet",
             f"{off_outlet:.0%} of the outflow left through the side or upstream boundary (above "
             f"{OFF_OUTLET_WARNING:.0%}): the region is cut short, widen the domain (domain.side, "
-            f"domain.upstream)", "docs/models/domain.md#open-boundaries"))
+            f"domain.upstream)", "docs/models/interface.md#outflow-off-outlet"))
     clearance = (pattern or {}).get("flooded_clearance_over_a")
     if clearance is not None and clearance < CLEARANCE_WARNING:
         where = pattern["flooded_nearest_boundary"]
@@ -65,7 +65,7 @@ def boundary_warnings(off_outlet: float | None, pattern: dict | None = None) -> 
             "region-near-boundary",
             f"the flooded region is {clearance:.2f} a from the {where} boundary (below "
             f"{CLEARANCE_WARNING:g} a): the boundary may hold or cut it, move it out "
-            f"({_BOUNDARY_KEY[where]})", "docs/models/domain.md#open-boundaries"))
+            f"({_BOUNDARY_KEY[where]})", "docs/models/interface.md#region-near-boundary"))
     return out
 
 
@@ -89,7 +89,7 @@ def rear_cell_warnings(rear_cell: float | None) -> list[Notice]:
                    f"the rear meniscus sits in {rear_cell:.2f} a cells (above "
                    f"{REAR_CELL_WARNING:g} a): its films, the oil held and the width are off, "
                    f"refine there (mesh.refine as in nominal_films.toml)",
-                   "docs/models/interface.md#rear-meniscus")]
+                   "docs/models/interface.md#rear-meniscus-cells")]
 
 
 def front_contact_line_cells(spec: CaseSpec, geom: CaseGeometry,
@@ -123,4 +123,4 @@ def front_cell_warnings(front_cells: float | None,
                    f"the front where dry walls run into it sits in cells {front_cells:.0f} wall "
                    f"cells wide (above {FRONT_CELL_WARNING:g}): width and inlet meniscus "
                    f"unconverged, physics.isotropic_compression = 1",
-                   "docs/models/interface.md#advancing-contact-line")]
+                   "docs/models/interface.md#front-contact-line-cells")]

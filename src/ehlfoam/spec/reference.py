@@ -223,6 +223,13 @@ def _summary(model: type[BaseModel]) -> str:
 
 
 # ---------------------------------------------------------------------- the walk
+def _name_in_file(name: str, field: FieldInfo) -> str:
+    """The key as a spec file writes it: the field's alias, or a placeholder the field names
+    (``json_schema_extra={"key": "<case-spec key>"}``: a table of any case-spec keys)."""
+    extra = field.json_schema_extra if isinstance(field.json_schema_extra, dict) else {}
+    return str(extra.get("key") or field.alias or name)
+
+
 def tables(root: type[BaseModel], where: str = "", note: str = "",
            instance: BaseModel | None = None, tag: str = "") -> Iterator[Table]:
     """The tables of ``root`` and of every model nested in it, depth first. ``instance``
@@ -230,7 +237,7 @@ def tables(root: type[BaseModel], where: str = "", note: str = "",
     names the kind of a tagged union's member."""
     rows, nested = [], []
     for name, field in root.model_fields.items():
-        key = f"{where}.{name}" if where else name
+        key = f"{where}.{_name_in_file(name, field)}" if where else _name_in_file(name, field)
         value = getattr(instance, name) if instance is not None else field.get_default(
             call_default_factory=True)
         rows.append(Row(key=key, type=type_text(field.annotation),
