@@ -45,9 +45,9 @@ def test_version_is_the_installed_packages(capsys):
 
 def test_every_subcommand_is_listed_and_has_its_module():
     names = list(subparsers(build_parser()))
-    assert names == ["doctor", "precalc", "case", "run", "band", "snapshot", "report", "batch",
-                     "foam"]
-    assert [m.__name__.rsplit(".", 1)[1] for m in COMMANDS] == names
+    assert names == ["doctor", "precalc", "thin-film", "case", "run", "band", "snapshot", "report",
+                     "batch", "foam"]
+    assert [m.__name__.rsplit(".", 1)[1] for m in COMMANDS] == [n.replace("-", "_") for n in names]
 
 
 @pytest.mark.parametrize("name", ["doctor", "precalc", "case", "run", "band", "snapshot",

@@ -48,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="ehlfoam",
         description="OpenFOAM cases of the oil flow around an EHL ball-on-disc contact.",
         epilog="OpenFOAM is chosen with EHLFOAM_FOAM=embedded|native|prefix,\n"
-               "EHLFOAM_FOAM_PREFIX and EHLFOAM_CACHE (see `ehlfoam doctor`).\n\n"
+               "EHLFOAM_FOAM_PREFIX and EHLFOAM_CACHE (docs/runtime.md; `ehlfoam doctor` checks it).\n\n"
                "example:\n"
                "  ehlfoam case examples/cases/nominal.toml --out runs/nominal "
                "--set mesh.resolution=coarse\n"
