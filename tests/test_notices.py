@@ -13,19 +13,19 @@ from tests.test_docs_links import ROOT, _anchors
 from tests.tiny import tiny_geometry
 
 REAR = Notice("rear-meniscus-cells", "the rear meniscus sits in 0.59 a cells (above 0.15 a)",
-              "docs/models/interface.md#rear-meniscus")
+              "docs/models/interface.md#rear-meniscus-cells")
 SIDE = Notice("outflow-off-outlet", "55% of the outflow left (through the side)",
-              "docs/models/domain.md")
+              "docs/models/interface.md")
 
 
 @pytest.mark.parametrize("code, text, docs, words", [
-    ("Rear", "x", "docs/a.md", "lowercase"),
-    ("rear cells", "x", "docs/a.md", "lowercase"),
-    ("rear", "x" * (MAX_TEXT + 1), "docs/a.md", f"at most {MAX_TEXT}"),
-    ("rear", "two\nlines", "docs/a.md", "one line"),
-    ("rear", "a; b", "docs/a.md", "without ';'"),
-    ("rear", "x", "cases.md", "not a docs pointer"),
-    ("rear", "x", "docs/cases.md, \"One step finer\"", "not a docs pointer"),
+    ("Rear", "x", "docs/validation.md", "lowercase"),
+    ("rear cells", "x", "docs/validation.md", "lowercase"),
+    ("rear", "x" * (MAX_TEXT + 1), "docs/validation.md", f"at most {MAX_TEXT}"),
+    ("rear", "two\nlines", "docs/validation.md", "one line"),
+    ("rear", "a; b", "docs/validation.md", "without ';'"),
+    ("rear", "x", "validation.md", "not a docs pointer"),
+    ("rear", "x", "docs/models/interface.md, \"The mesh\"", "not a docs pointer"),
 ])
 def test_a_notice_is_one_short_line_with_a_code_and_a_docs_pointer(code, text, docs, words):
     with pytest.raises(ValueError, match=words):
@@ -35,12 +35,12 @@ def test_a_notice_is_one_short_line_with_a_code_and_a_docs_pointer(code, text, d
 def test_metrics_text_reads_back():
     text = to_text([REAR, SIDE])
     assert text == ("[rear-meniscus-cells] the rear meniscus sits in 0.59 a cells (above 0.15 a) "
-                    "(docs/models/interface.md#rear-meniscus); [outflow-off-outlet] 55% of the "
-                    "outflow left (through the side) (docs/models/domain.md)")
+                    "(docs/models/interface.md#rear-meniscus-cells); [outflow-off-outlet] 55% of "
+                    "the outflow left (through the side) (docs/models/interface.md)")
     assert from_text(text) == [REAR, SIDE]
     assert from_text("") == [] and from_text(None) == [] and to_text([]) == ""
     with pytest.raises(ValueError, match="not a notice"):
-        from_text("the rear meniscus sits in 0.43 a cells; docs/cases.md, \"One step finer\"")
+        from_text("the rear meniscus sits in 0.43 a cells (above 0.15 a): they lay wall films")
 
 
 def test_a_batch_shows_each_code_once_and_counts_the_cases():

@@ -30,7 +30,7 @@ _SEPARATOR = "; "
 class Notice:
     """A warning about a case: ``code`` (stable, lowercase words joined by '-'), ``text`` (one
     line of at most :data:`MAX_TEXT` characters, no ';'), ``docs`` (a docs file and section,
-    ``docs/models/interface.md#rear-meniscus``)."""
+    ``docs/models/interface.md#rear-meniscus-cells``)."""
 
     code: str
     text: str

@@ -209,7 +209,7 @@ def test_ramp_start_on_another_mesh_is_interpolated(tiny, tmp_path):
     structure = case_fields.Structure.load(case)
     seeded = case_fields.initial_oil_volume(case, structure, load_geometry(case))
     final = json.loads((previous / "metrics.json").read_text())["oil_volume_m3"]
-    # interpolated, then put back to the previous case's oil volume (runs/field_mapping.py)
+    # interpolated, then put back to the previous case's oil volume (ehlfoam.seed.mapping)
     assert info["oil"]["conserved"] and info["oil"]["interpolated_m3"] != pytest.approx(
         info["oil"]["source_m3"], rel=1e-6, abs=0)
     assert seeded == pytest.approx(final, rel=1e-6, abs=0)

@@ -192,7 +192,7 @@ def test_shipped_batch_specs_keep_their_case_ids():
 @pytest.mark.parametrize("path", sorted((Path(__file__).resolve().parents[2] / "examples")
                                         .glob("*/*.toml")), ids=lambda p: p.name)
 def test_tracked_specs_are_valid(path):
-    """Every spec under runs/ that the docs tell users to run is a valid case spec, or a batch
+    """Every spec under examples/ that the docs tell users to run is a valid case spec, or a batch
     spec that expands into valid case specs: a renamed or retired key fails here, not in a
     user's hands."""
     from ehlfoam._io import read_toml

@@ -125,7 +125,8 @@ def test_spec_defaults_are_the_reference_case():
     spec = make_case_spec()
     assert spec.contact.load == 20.0 and spec.contact.temperature == 40.0
     assert spec.speed == 0.008
-    assert spec.a == pytest.approx(0.137e-3, rel=0.01)          # ball_on_disc.md
+    # the reference's Hertzian radius (docs/reference.md#conditions-thesis-table-21)
+    assert spec.a == pytest.approx(0.137e-3, rel=0.01)
     assert spec.physics.surface_tension == 0.030 and spec.physics.contact_angle == 15.0
     assert spec.oil_viscosity == pytest.approx(21.6e-3)
     with pytest.raises(SpecError, match="track_half_width"):
@@ -456,12 +457,14 @@ def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     assert m["state"] in ("I", "II")
     assert m["oil_volume_m3"] > 0
     # over 1 ms the outlet flux flickers between 15 writes (trapezoid error); runs to steady
-    # state balance within 1 % (docs/cases.md). This catches a lost factor or sign.
+    # state balance within 1 % (docs/validation.md#v-mass-balance). This catches a lost factor
+    # or sign.
     assert m["oil_mass_balance_error"] is not None and m["oil_mass_balance_error"] < 0.1
     assert m["oil_flux_source"] == OIL_FLUX_EXACT
     assert m["oil_inflow_m3_s"] == pytest.approx(0.02 * 6e-6 * 5e-4, rel=1e-6)
     # the upstream boundary takes air in and lets no oil out (its alpha is fixed: with
-    # inletOutlet the flickering face flux pumped oil out there, docs/cases.md)
+    # inletOutlet the flickering face flux pumped oil out there,
+    # docs/models/interface.md#physics)
     last = case_fields.time_folders(case)[-1][1]
     oil_up = FoamFieldFile(last / "alphaPhi0.oil").boundary_field["inlet"]["value"]
     assert np.all(np.asarray(oil_up) == 0.0)
@@ -599,7 +602,8 @@ def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
     assert (case / "log.interPhaseChangeFoam").read_text().rstrip().endswith("End")
     assert 0.97 * p_release < m["min_pressure_Pa"] < spec.physics.ambient_pressure
     # holding the pressure there takes more gas than the supply brings in dissolved (5.7
-    # times here): the release has no budget, and the run says so (docs/cavitation.md)
+    # times here): the release has no budget, and the run says so
+    # (docs/models/gas-release.md#physics)
     assert 0.0 < m["gas_released_m3"] < m["dissolved_air_m3"]   # the puddle's air, in 1 ms
     assert m["gas_release_over_dissolved_inflow"] > 1.0, m["gas_release_over_dissolved_inflow"]
     # all-oil supply faces (ehlfoam.case.fields.supply_faces): 1.8 % here, 5.5 % with
@@ -954,7 +958,7 @@ def test_static_meniscus_stays_put(tmp_path):
     """Walls at rest, no supply, a puddle around the island, default settings (the polar
     ring, cAlpha 1): the meniscus stays where it started, the oil volume holds, and the
     spurious currents stay below the level measured for these defaults (a regression guard:
-    the issue's 1 % of u is not reached at cAlpha 1, docs/cases.md)."""
+    the issue's 1 % of u is not reached at cAlpha 1, docs/validation.md#v-static-meniscus)."""
     from foamlib import FoamFieldFile
 
     from ehlfoam.run import fields as case_fields
@@ -970,9 +974,10 @@ def test_static_meniscus_stays_put(tmp_path):
     last = case_fields.time_folders(case)[-1][1]
     U = np.linalg.norm(np.asarray(FoamFieldFile(last / "U").internal_field, float), axis=1)
     alpha = np.asarray(FoamFieldFile(last / "alpha.oil").internal_field, float)
-    # measured (docs/cases.md, "The static meniscus"): the 99th percentile of the speed in
-    # the oil is ~10 % of u with the default interface compression; the issue's 1 % is not
-    # reached. This guards against regressions of that level and of the meniscus position.
+    # measured on this case: the 99th percentile of the speed in the oil is ~10 % of u with
+    # the default interface compression (at rest the default schemes give 1-16 % of u,
+    # docs/validation.md#v-static-meniscus); the issue's 1 % is not reached. This guards
+    # against regressions of that level and of the meniscus position.
     u_oil = float(np.percentile(U[alpha > 0.99], 99))
     assert u_oil < 0.2 * spec.speed, f"spurious velocity in the oil {u_oil:.3g} m/s"
     # within a third of the test mesh's cells there (~0.6 a; 0.03 a at the coarse level)
@@ -981,8 +986,8 @@ def test_static_meniscus_stays_put(tmp_path):
 
 
 #: (puddle radius [a], run options) of the static meniscus below 1 % of u at the default
-#: compression (cAlpha 1), both with the balanced interface schemes; docs/cases.md, "Sub-cycles
-#: and the capillary limit" and "The static meniscus where the rolling one sits".
+#: compression (cAlpha 1), both with the balanced interface schemes;
+#: docs/validation.md#v-static-meniscus, docs/models/interface.md#numerics.
 QUIET_STATICS = {
     # at 3 a, the thinnest gap tried: three MULES sub-cycles and half the capillary limit
     # (measured on this case: 0.70 %; on the nominal gap, second half / last quarter: 0.44 /

@@ -44,8 +44,8 @@ def test_a_region_near_an_open_boundary_is_flagged():
 
 def test_the_cells_at_the_rear_meniscus_are_read_off_the_spec_and_coarse_ones_flagged():
     """The default medium level's rear meniscus (11 a behind the contact on y = 0) sits in its
-    far-field cells; runs/nominal_films.toml's box puts 0.1 a cells there; an open wake has no
-    rear meniscus."""
+    far-field cells; examples/cases/nominal_films.toml's box puts 0.1 a cells there; an open
+    wake has no rear meniscus."""
     root = Path(__file__).resolve().parents[2] / "examples" / "cases"
     nominal, films = (load_case_spec(root / n) for n in ("nominal.toml", "nominal_films.toml"))
     closed = {"state": "I", "flooded_x_max_over_a": 11.0}

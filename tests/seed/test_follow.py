@@ -139,10 +139,11 @@ def test_cli_case_follows_the_meniscus_of_the_state_it_starts_from(tmp_path):
 
 
 def test_the_shipped_resolved_nominal_spec_is_the_converged_families_medium_level():
-    """runs/nominal_resolved.toml: the nominal case on the medium following level under the
-    contact-line model whose three levels converge (docs/cases.md, "The front in the side
-    cells on all three levels"): the side band round the front off the track, walls halving
-    with the side cells, 1 um slip, a 43 deg wall."""
+    """examples/cases/nominal_resolved.toml: the nominal case on the medium following level
+    under the contact-line model whose three levels converge
+    (docs/models/interface.md#the-contact-line-model-and-what-converges): the side band
+    round the front off the track, walls halving with the side cells, 1 um slip, a 43 deg
+    wall."""
     from ehlfoam.spec.case import load_case_spec
 
     spec = load_case_spec(ROOT / "examples" / "cases" / "nominal_resolved.toml")

@@ -31,10 +31,9 @@ WHOLE_GAP_SUPPLIES = ("flooded", "submerged")
 _LAYERS = ("supply.disc_layer", "supply.ball_layer")
 
 #: Rough cost model for ordering (longest first) and the first ETA: CPU seconds per simulated
-#: millisecond per resolution level with the time-step defaults of 2026-11-23 (docs/cases.md,
-#: "Time-step limits": coarse 0.14-0.17 s at 8 mm/s, medium 0.65-0.84 s; fine scaled from the
-#: earlier defaults by the medium level's factor), plus a fixed build cost and the EHL precalc
-#: of a new contact.
+#: millisecond per resolution level, measured with the time-step defaults of 2026-11-23 (fine
+#: scaled from the earlier defaults by the medium level's factor), plus a fixed build cost and
+#: the EHL precalc of a new contact (docs/batches.md#cost-model).
 CPU_PER_SIMULATED_MS = {"coarse": 0.17, "medium": 0.75, "fine": 3.0}
 BUILD_CPU_S = 5.0
 PRECALC_CPU_S = 60.0

@@ -55,7 +55,8 @@ def _balance_interface_schemes(case: Path) -> None:
     exact discrete balance on non-orthogonal faces), the interface normal comes from a
     smoother point-cells least-squares gradient, and the compression flux is limited to the
     interface. Calmer at rest, but the uncorrected gradients are an error on non-orthogonal
-    faces in a rolling case (see docs/models.md)."""
+    faces in a rolling case (docs/models/interface.md#numerics,
+    docs/models/single-phase.md)."""
     with FoamFile(case / "system" / "fvSchemes") as f:
         f["snGradSchemes"]["default"] = "uncorrected"
         f["laplacianSchemes"]["default"] = ("Gauss", "linear", "uncorrected")

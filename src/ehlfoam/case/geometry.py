@@ -77,7 +77,7 @@ class CaseGeometry:
 #: the median ball wall steps (ehlfoam.mesh.wall_steps) above which a case is flagged: the
 #: three levels give 7-9; at 15-90 (thinner wall cells under the same in-plane cells) a
 #: spurious oil film creeps along the ball beside the flooded region and 10-54 % of the
-#: outflow leaves through the side (see docs/models.md)
+#: outflow leaves through the side (docs/models/interface.md#ball-wall-steps)
 BALL_WALL_STEPS_LIMIT = 10.0
 
 

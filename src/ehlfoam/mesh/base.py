@@ -91,7 +91,7 @@ def build_base_mesh(params: MeshParams, size: SizeFunction,
     radius), the rest is meshed freely. A meniscus that follows a circle
     about the contact then meets every cell of the ring the same way, so
     the error of its discrete curvature does not change from cell to cell
-    along it (see docs/models.md).
+    along it (docs/models/interface.md#the-mesh).
     """
     import gmsh
 
@@ -114,7 +114,8 @@ def build_base_mesh(params: MeshParams, size: SizeFunction,
     with gmsh_model("ehlfoam-gap"):
         if params.polar_radius is not None:
             # blossom recombination leaves quads 40-58 degrees non-orthogonal along the
-            # ring's fixed nodes; simple full-quad keeps them below ~30 (see docs/models.md)
+            # ring's fixed nodes; simple full-quad keeps them below ~30
+            # (docs/models/interface.md#the-mesh)
             gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 2)
         curves = add_geometry(mesh_params, divisions)
         interrupts: list[BaseException] = []

@@ -200,7 +200,7 @@ def extrude(base: BaseMesh, gap: GapFunction, n_layers: int,
     (the line between two cell centres follows the sloping level, the face between them
     stands upright), and makes the wall cells meet both walls at right angles. On the
     nominal case this removed an oil film that crept off the track along the ball
-    (see docs/models.md).
+    (docs/models/interface.md#the-mesh).
     """
     L = check_n_layers(n_layers)
     points2, quads = np.asarray(base.points, float), np.asarray(base.quads, np.int64)
@@ -263,7 +263,7 @@ def wall_steps(base: BaseMesh, mesh: PolyMesh) -> np.ndarray:
     ``mesh = extrude(base, ...)`` (its node columns: disc, the wall cell's top, ..., ball).
     Where the ball slopes (|grad h| ~ r / R), thin wall cells under wide quads stair-step
     along it; above ~10 steps a spurious oil film creeps along the ball beside the flooded
-    region (see docs/models.md)."""
+    region (docs/models/interface.md#ball-wall-steps)."""
     quads = np.asarray(base.quads, np.int64)
     column_z = mesh.points[:, 2].reshape(len(base.points), -1)   # extrude's node order
     h, wall = column_z[quads, -1], column_z[quads, 1]

@@ -52,7 +52,8 @@ def column_fractions(h: np.ndarray, n_layers: int, wall_cell: float,
     everywhere puts thin cells (a small share of the gap) where the gap is wide, at the rear
     meniscus whose films they must hold, and thick ones near the contact, where the dry walls
     run into the region's front and in-plane cells within some 15 wall cells suffice
-    (see docs/models.md)."""
+    (docs/models/interface.md#the-mesh; the 15 wall cells:
+    docs/models/interface.md#the-contact-line-model-and-what-converges)."""
     h = np.asarray(h, float)
     s = np.arange(n_layers + 1) / n_layers
     if n_layers < 3:

@@ -121,7 +121,7 @@ def split_patch(mesh: PolyMesh, name: str, select: np.ndarray, new_name: str,
 
 _BANNER = """\
 /*--------------------------------*- C++ -*----------------------------------*\\
-| ehlfoam: thin-gap mesh (generator/mesh.py)                                  |
+| ehlfoam: thin-gap mesh (ehlfoam.mesh.polymesh)                              |
 \\*---------------------------------------------------------------------------*/
 """
 #: Rows formatted per chunk when writing large lists.

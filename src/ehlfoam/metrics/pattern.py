@@ -221,8 +221,9 @@ def advancing_front(r: Raster, track_half_width: float, threshold: float = 0.5) 
     """Points (x, y) [m], shape (n, 2), of the flooded region's edge that the walls, rolling
     along +x, run into from dry ground: flooded pixels whose upstream neighbour is neither
     flooded nor island, off the supply track (|y| > ``track_half_width`` [m]). There the oil
-    meets the walls in contact lines advancing onto dry walls (docs/cases.md, "The region's
-    sides are moving contact lines"). Empty without a flooded region."""
+    meets the walls in contact lines advancing onto dry walls
+    (docs/models/interface.md#the-contact-line-model-and-what-converges). Empty without a
+    flooded region."""
     if not isinstance(r, Raster):
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
     if not (math.isfinite(track_half_width) and track_half_width >= 0):
@@ -382,7 +383,8 @@ def flooded_widths_at(r: Raster, x_stations: Any, threshold: float = 0.5) -> lis
     end at the interpolated ``alpha = threshold`` crossing (as ``flooded_width_over_a``,
     which is their largest over all x); None where the region does not reach that column.
     The outline behind the widest point (the rear shoulders) moves with the mesh where the
-    widest point does not (docs/cases.md)."""
+    widest point does not
+    (docs/models/interface.md#the-contact-line-model-and-what-converges)."""
     threshold = check_threshold(threshold)
     if not isinstance(r, Raster):
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")

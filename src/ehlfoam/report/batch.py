@@ -45,7 +45,8 @@ __all__ = ["after_batch", "bubble_points", "make_case_reports", "report_batch", 
 PARAMETERS = ("contact.speed", "supply.disc_layer", "supply.ball_layer", "contact.load",
               "contact.temperature")
 #: Ambient minus cavitation pressure of the bubble relation when the spec has none [Pa]
-#: (ambient 1.013e5 Pa, cavitation at 0 Pa absolute: ball_on_disc.md).
+#: (ambient 1.013e5 Pa, cavitation at 0 Pa absolute:
+#: docs/reference.md#conditions-thesis-table-21).
 DP_DEFAULT = 1.013e5
 #: Frames of a case's GIF when the batch report makes the case report (a third of the
 #: time of a full one).

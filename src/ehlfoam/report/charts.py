@@ -1,9 +1,10 @@
 """Charts (matplotlib): a case's history, and a batch's bubble length and flow states.
 
-History: the quantities the monitor's steady-state test tracks (runs/run_case.py
-``_steady``: oil volume, meniscus positions, flooded size, gas behind the contact / bubble
-length), against time, with the last transit window and the test's tolerance band drawn, so
-that a reader sees whether the run settled and by how much it missed.
+History: the quantities the monitor's steady-state test tracks
+(:func:`ehlfoam.run.steady.steady_test`: oil volume, meniscus positions, flooded size, gas
+behind the contact / bubble length), against time, with the last transit window and the
+test's tolerance band drawn, so that a reader sees whether the run settled and by how much
+it missed.
 """
 
 from __future__ import annotations

@@ -194,8 +194,8 @@ def smeared_oil_fraction(alpha: np.ndarray, cell_volumes: np.ndarray) -> float |
     (:data:`SMEARED_ALPHA`): how diffuse the interface is. A thin-gap meniscus is one or two
     cells wide in the plane, so a sharp run keeps a small, level-dependent share; the
     interface-limited compression scheme (``physics.interface_schemes = "balanced"``)
-    raised it from 31 % to 44-48 % on the coarse nominal case (docs/cases.md). None without
-    oil."""
+    raised it from 31 % to 44-48 % on the nominal case (docs/validation.md#v-balanced-rolling).
+    None without oil."""
     a = np.clip(np.asarray(alpha, float), 0.0, 1.0)
     oil = a * np.asarray(cell_volumes, float)
     total = float(oil.sum())

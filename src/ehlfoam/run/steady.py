@@ -91,8 +91,8 @@ def _oil_trend_within(history: list[Sample], window: float, tol: float) -> bool:
     ``tol`` of itself per window.
 
     Both tests below compare two points or two means a window apart; a flooded region that
-    had settled and then starts to fill again can pass them while the oil still rises (a run
-    of 2026-11-24 passed "window mean" rising 1.75 % a transit, docs/cases.md). The trend
+    had settled and then starts to fill again can pass them while the oil still rises
+    (docs/models/interface.md#running-steady-state-starting-from-other-states). The trend
     over the last window sees that."""
     now = history[-1].time
     last = [s for s in history if s.time >= now - window * (1 + 1e-9)]

@@ -19,24 +19,23 @@ __all__ = ["CLEARANCE_WARNING", "FRONT_CELL_WARNING", "OFF_OUTLET_WARNING",
            "front_contact_line_cells", "rear_cell_warnings", "rear_meniscus_cell"]
 
 #: share of the outflow leaving off the outlet above which a run is flagged: the region (or a
-#: wall film) reached the side or upstream boundary, e.g. a width of 15.5 a against a side at
-#: 8 a (docs/cases.md, "The films decide the width")
+#: wall film) reached the side or upstream boundary
+#: (docs/models/interface.md#outflow-off-outlet)
 OFF_OUTLET_WARNING = 0.05
 #: flooded region nearer an open boundary than this (units a) is flagged: its meniscus feels
 #: the boundary's fixed pressure, and at the outlet the oil leaves in bulk instead of as the
-#: films the rear meniscus lays (a film-resolving run's rear reached 13.5 a against a 14 a
-#: outlet, docs/cases.md "What the films converge to")
+#: films the rear meniscus lays (docs/models/interface.md#region-near-boundary)
 CLEARANCE_WARNING = 1.0
 #: in-plane cells at the rear meniscus coarser than this (units a) are flagged: they lay wall
 #: films thicker than Landau-Levich's (1.6-2.1 times at 0.55 a, 1.0 at 0.1 a on the 2D strip),
-#: and the flooded width comes out short (the default levels' 0.4-0.8 a cells by 16-20 %
-#: against a run at 0.1 a, 11-16 % against one at 0.05 a on the rear arc; docs/cases.md, "One
-#: step finer at the rear meniscus")
+#: and the flooded width comes out short (the default levels' 0.4-0.8 a cells by 17-21 %
+#: against the converged width; docs/models/interface.md#rear-meniscus-cells,
+#: docs/validation.md#v-films)
 REAR_CELL_WARNING = 0.15
 #: The in-plane cells over the wall cell's height along the flooded region's front off the
 #: track, where dry walls run into it, above which a run warns: in the contact-line strip the
-#: meniscus holds no capillary suction beyond some 15 (docs/cases.md, "The region's sides are
-#: moving contact lines").
+#: meniscus holds no capillary suction beyond some 15
+#: (docs/models/interface.md#front-contact-line-cells, docs/validation.md#v-contact-line).
 FRONT_CELL_WARNING = 15.0
 
 
@@ -115,8 +114,7 @@ def front_cell_warnings(front_cells: float | None,
     """A warning when the region's front off the track, where dry walls run into it, sits in
     cells wider than :data:`FRONT_CELL_WARNING` wall cells; none with the compression taken
     from the local speed (``physics.isotropic_compression = 1``), with which the advancing
-    line holds on any cells (docs/cases.md, "The advancing contact line and the interface
-    compression")."""
+    line holds on any cells (docs/models/interface.md#numerics)."""
     if front_cells is None or front_cells <= FRONT_CELL_WARNING or isotropic_compression == 1.0:
         return []
     return [Notice("front-contact-line-cells",

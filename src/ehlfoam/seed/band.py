@@ -1,13 +1,13 @@
 """Bands of finer cells along a run's meniscus, for the next run's mesh (``ehlfoam band``).
 
-A meniscus in the thin gap holds its capillary suction only in in-plane cells of a few wall
-cells where dry walls run into it, and lays its films right only in cells of 0.05-0.1 a at the
-rear (see docs/models.md). Hand-placed boxes (``mesh.refine``) covered it piece by piece;
-this module reads the meniscus itself off a written time, the ``alpha = 0.5`` lines of the
-mid-gap oil fraction, and turns each line into a :class:`~ehlfoam.spec.mesh.RefineBand` of a
-chosen size and half-width in the half domain y >= 0. A run continued from that write
-(``--start-from``) on a mesh with the bands then has its whole meniscus in the band's cells, as
-long as the meniscus stays within the band.
+A meniscus in the thin gap holds its capillary suction only in in-plane cells within about 15
+wall cells where dry walls run into it, and lays its films right only in cells of 0.05-0.1 a at
+the rear (docs/models/interface.md#the-contact-line-model-and-what-converges). Hand-placed
+boxes (``mesh.refine``) covered it piece by piece; this module reads the meniscus itself off a
+written time, the ``alpha = 0.5`` lines of the mid-gap oil fraction, and turns each line into a
+:class:`~ehlfoam.spec.mesh.RefineBand` of a chosen size and half-width in the half domain
+y >= 0. A run continued from that write (``--start-from``) on a mesh with the bands then has
+its whole meniscus in the band's cells, as long as the meniscus stays within the band.
 
     ehlfoam band CASE --size 0.06 --half-width 1.0 [--time last|start|T] [--spacing 0.25]
         [--min-length 1.0]

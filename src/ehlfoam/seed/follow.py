@@ -3,8 +3,8 @@
 The levels of :data:`~ehlfoam.spec.levels.RESOLUTIONS` leave the meniscus in their base cells,
 and the flooded width does not converge over them; with bands of cells along the whole
 meniscus, twice as fine on the region's sides, and one thin wall cell everywhere
-(:data:`~ehlfoam.spec.levels.FOLLOW_LEVELS`), the meniscus is resolved on every level (see
-docs/models.md). A case of such a level is written in three steps:
+(:data:`~ehlfoam.spec.levels.FOLLOW_LEVELS`), the meniscus is resolved on every level
+(docs/models/interface.md#the-mesh). A case of such a level is written in three steps:
 
 1. a probe case on the level's base mesh, without bands, started from the source
    (``--start-from``: a run case, a case snapshot or a thin-film state);

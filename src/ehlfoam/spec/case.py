@@ -124,7 +124,8 @@ class CaseSpec(BaseModel):
         initial oil fraction, and never again (the correct() of its phase-change models is
         empty, so incompressibleTwoPhaseMixture::calcNu is not called): oil that reaches a cell
         that started as air keeps the air's kinematic viscosity. With equal kinematic
-        viscosities the frozen field is right everywhere (docs/cavitation.md)."""
+        viscosities the frozen field is right everywhere
+        (docs/models/gas-release.md#physics)."""
         if self.scene == "gas-release":
             return self.physics.air_density * self.oil_viscosity / self.oil_density
         return self.physics.air_viscosity * self.run.air_viscosity_factor

@@ -39,7 +39,8 @@ conserved to round-off; the step is a quarter of a cell's transit at u (the nomi
 holds 173.6 / 173.7 / 173.7 nl at a quarter, an eighth and a sixteenth; with the menisci at
 the open cells' centres it moved by 6-16 % at each halving of the step, as they jumped a
 cell at a time). The nominal problem has two balanced states, reached from above and from a
-puddle: 170.1 and 161.4 nl, 15.80 and 15.55 a wide on 0.05 a cells (see docs/models.md).
+puddle: 170.1 and 161.4 nl, 15.80 and 15.55 a wide on 0.05 a cells
+(docs/models/thin-film.md#what-it-gives-the-nominal-case-8-mms-8-um-layers).
 
 This is the mass-conserving cavitation model of lubrication (Elrod-Adams; Jakobsson,
 Floberg and Olsson's conditions) with two changes that make it a model of this flow: the
