@@ -90,7 +90,7 @@ def tiny(tmp_path_factory):
     (BASE + "[sweep]\ncontact.speed = []\n", "sweep.contact.speed = []: empty sweep"),
     (BASE + "[sweep]\ncontact.speed = [0.01, -0.005]\n",
      "sweep: contact.speed = -0.005: Input should be greater than 0 (valid range 0 < "
-     "contact.speed <= 100)"),
+     "contact.speed <= 100 m/s)"),
     (BASE + "[[ramp]]\nname = \"A\"\n",
      "ramp[0].contact.speed: missing: a ramp needs its speeds"),
     (BASE + "[[ramp]]\nname = \"A\"\ncontact.speed = []\n", "a ramp without speeds"),
