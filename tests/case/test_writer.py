@@ -192,8 +192,7 @@ def test_meshed_gap_matches_the_gap_export(level, ring):
     spec = make_case_spec({**SMALL, "mesh": {"resolution": level}})
     gap, _ = load_gap(spec.contact)
     a, d = spec.a, spec.domain
-    params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
-                        island_radius=d.island_radius * a, n_layers=2,
+    params = MeshParams(**spec.domain.box(a).fields(), n_layers=2,
                         polar_radius=0.8 * min(d.upstream, d.downstream, d.side) * a
                         if ring else None)
     mesh = extrude(build_base_mesh(params, size_function(spec)), gap, 2)
@@ -206,9 +205,8 @@ def test_a_refinement_box_refines_the_free_quads_inside_it():
     from ehlfoam.mesh import REFINE_GROWTH, MeshParams, build_base_mesh, size_function
 
     def base(spec):
-        a, d = spec.a, spec.domain
-        params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
-                            island_radius=d.island_radius * a, n_layers=2,
+        a = spec.a
+        params = MeshParams(**spec.domain.box(a).fields(), n_layers=2,
                             polar_radius=spec.polar_radius * a)
         mesh = build_base_mesh(params, size_function(spec))
         centre = mesh.points[mesh.quads].mean(axis=1) / a
@@ -275,9 +273,7 @@ def test_a_band_refines_the_free_quads_along_its_line():
     assert size(-4.0 * a, 0.5 * a) == pytest.approx((0.2 + REFINE_GROWTH * beyond) * a, rel=0.01)
     plain = make_case_spec({**SMALL, "mesh": free})
     assert size(3.0 * a, 0.0) == pytest.approx(size_function(plain)(3.0 * a, 0.0))
-    d = spec.domain
-    params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
-                        island_radius=d.island_radius * a, n_layers=2, polar_radius=None)
+    params = MeshParams(**spec.domain.box(a).fields(), n_layers=2, polar_radius=None)
     mesh = build_base_mesh(params, size)
     c = mesh.points[mesh.quads].mean(axis=1) / a
     cell = np.sqrt(mesh.quad_areas()) / a

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ehlfoam.notices import Notice
 from ehlfoam.spec.case import CaseSpec
+from ehlfoam.spec.sections import DomainBox
 
 META = "ehlfoam"  # the case's own folder of generator outputs
 
@@ -57,6 +58,13 @@ class CaseGeometry:
     #: the oil fraction of what flows in through the boundaries open to the outside: 0 (air)
     #: but where oil fills the domain (single-phase scene, submerged supply)
     open_inflow_oil: float = 0.0
+
+    @property
+    def box(self) -> DomainBox:
+        """The meshed domain's rectangle [m] (the one record the mesh and the metrics
+        extend)."""
+        return DomainBox(x_min=self.x_min, x_max=self.x_max, y_max=self.y_max,
+                         island_radius=self.island_radius, symmetric=self.symmetric)
 
     @property
     def mirror(self) -> float:

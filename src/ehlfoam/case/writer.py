@@ -73,10 +73,8 @@ def case_mesh(spec: CaseSpec, gap) -> tuple[MeshParams, BaseMesh, PolyMesh, np.n
     """The mesh :func:`write_case` writes for ``spec`` on the gap h(x, y) [m]: its parameters,
     the 2D base mesh, the extruded mesh with its supply patch, and the supply faces' oil
     fractions."""
-    a, d = spec.a, spec.domain
-    params = MeshParams(x_min=-d.upstream * a, x_max=d.downstream * a, y_max=d.side * a,
-                        island_radius=d.island_radius * a, n_layers=spec.mesh.level()["n_layers"],
-                        symmetric=d.symmetry == "half",
+    a = spec.a
+    params = MeshParams(**spec.domain.box(a).fields(), n_layers=spec.mesh.level()["n_layers"],
                         polar_radius=None if spec.polar_radius is None
                         else spec.polar_radius * a)
     base = build_base_mesh(params, size_function(spec))

@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ehlfoam.spec.sections import DomainBox
+
 #: Patch name -> OpenFOAM patch type, in the order the patches are written.
 PATCH_TYPES: dict[str, str] = {
     "disc": "wall",
@@ -56,69 +58,28 @@ def check_n_layers(n_layers: object) -> int:
     return int(n_layers)
 
 
-@dataclass(frozen=True)
-class MeshParams:
-    """Geometry of the thin-gap domain (metres).
+@dataclass(frozen=True, kw_only=True)
+class MeshParams(DomainBox):
+    """The thin-gap domain (:class:`~ehlfoam.spec.sections.DomainBox`, metres) and what the
+    mesher needs beside it: ``n_layers``, the number of cells across the gap, and
+    ``polar_radius`` [m] (None: no ring), the outer radius of a structured polar ring around
+    the island (see :func:`build_base_mesh`), which must lie between the island and the
+    nearest boundary."""
 
-    The rectangle is ``x_min <= x <= x_max`` and ``0 <= y <= y_max``
-    (``symmetric=True``: half domain, symmetry plane y = 0) or
-    ``-y_max <= y <= y_max`` (full domain). The circular hole of radius
-    ``island_radius`` at the origin must lie strictly inside it:
-    ``x_min < -island_radius``, ``island_radius < x_max``,
-    ``island_radius < y_max``. ``n_layers`` is the number of cells across
-    the gap. ``polar_radius`` (None: no ring) is the outer radius of a
-    structured polar ring around the island (see :func:`build_base_mesh`);
-    ``island_radius < polar_radius`` and the ring must lie strictly inside
-    the rectangle.
-    """
-
-    x_min: float
-    x_max: float
-    y_max: float
-    island_radius: float
     n_layers: int
-    symmetric: bool = True
     polar_radius: float | None = None
 
     def __post_init__(self) -> None:
-        for name in ("x_min", "x_max", "y_max", "island_radius"):
-            _require_finite(name, getattr(self, name))
-        r = float(self.island_radius)
-        if r <= 0:
-            raise ValueError(f"island_radius must be > 0 m, got {self.island_radius!r}")
-        if not self.x_min < -r:
-            raise ValueError(
-                f"x_min must be < -island_radius = {-r:.6g} m (the island must lie inside "
-                f"the rectangle), got x_min = {self.x_min!r}")
-        if not self.x_max > r:
-            raise ValueError(
-                f"x_max must be > island_radius = {r:.6g} m (the island must lie inside "
-                f"the rectangle), got x_max = {self.x_max!r}")
-        if not self.y_max > r:
-            raise ValueError(
-                f"y_max must be > island_radius = {r:.6g} m (the island must lie inside "
-                f"the rectangle), got y_max = {self.y_max!r}")
+        super().__post_init__()
         check_n_layers(self.n_layers)
         if self.polar_radius is not None:
             rp = _require_finite("polar_radius", self.polar_radius)
+            r = float(self.island_radius)
             nearest = min(-float(self.x_min), float(self.x_max), float(self.y_max))
             if not r < rp < nearest:
                 raise ValueError(
                     f"polar_radius must lie between island_radius = {r:.6g} m and the nearest "
                     f"boundary ({nearest:.6g} m from the centre), got {self.polar_radius!r}")
-        if not isinstance(self.symmetric, (bool, np.bool_)):
-            raise ValueError(f"symmetric must be True or False, got {self.symmetric!r}")
-
-    @property
-    def y_min(self) -> float:
-        """Lower y bound of the domain (m): 0 (half domain) or -y_max."""
-        return 0.0 if self.symmetric else -float(self.y_max)
-
-    @property
-    def area(self) -> float:
-        """Exact area of the domain (m^2): rectangle minus (half) disc."""
-        hole = math.pi * self.island_radius**2 * (0.5 if self.symmetric else 1.0)
-        return (self.x_max - self.x_min) * (self.y_max - self.y_min) - hole
 
 
 @dataclass

@@ -25,6 +25,8 @@ from typing import Any
 import numpy as np
 from scipy.spatial import QhullError
 
+from ehlfoam.spec.sections import DomainBox
+
 __all__ = ["Geometry", "Raster", "check_threshold", "raster"]
 
 #: Default raster spacing as a fraction of the contact radius ``a``.
@@ -37,44 +39,27 @@ ALPHA_TOLERANCE = 0.5
 DOMAIN_SLACK = 0.01
 
 
-@dataclass(frozen=True)
-class Geometry:
-    """The domain around the contact, all lengths in metres.
-
-    ``a``: Hertzian contact radius; ``island_radius``: radius of the mesh's
-    hole at the origin (``>= a``); ``x_min < -island_radius`` and
-    ``x_max > island_radius``: inlet and outlet ends; ``y_max >
-    island_radius``: the side edge(s); ``symmetric``: the mesh covers
-    ``y >= 0`` only (mirrored for the analysis), else ``|y| <= y_max``.
-    """
+@dataclass(frozen=True, kw_only=True)
+class Geometry(DomainBox):
+    """The domain around the contact (:class:`~ehlfoam.spec.sections.DomainBox`, metres) with
+    the Hertzian contact radius ``a`` [m] the metrics are measured in; the island (the mesh's
+    hole at the origin) is at least as large as the contact, ``island_radius >= a``. A half
+    domain (``symmetric``) is mirrored for the analysis."""
 
     a: float
-    island_radius: float
-    x_min: float
-    x_max: float
-    y_max: float
-    symmetric: bool = True
 
     def __post_init__(self) -> None:
-        for name in ("a", "island_radius", "x_min", "x_max", "y_max"):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
-                raise ValueError(f"{name}: must be a finite number, got {value!r}")
-        if self.a <= 0:
-            raise ValueError(f"a: must be > 0, got {self.a!r}")
+        if (isinstance(self.a, bool) or not isinstance(self.a, (int, float, np.integer, np.floating))
+                or not math.isfinite(self.a) or self.a <= 0):
+            raise ValueError(f"a: must be a finite number > 0 in metres, got {self.a!r}")
+        super().__post_init__()
         if self.island_radius < self.a:
             raise ValueError(f"island_radius: must be >= a ({self.a!r}), got {self.island_radius!r}")
-        if self.x_min >= -self.island_radius:
-            raise ValueError(f"x_min: must be < -island_radius, got {self.x_min!r}")
-        if self.x_max <= self.island_radius:
-            raise ValueError(f"x_max: must be > island_radius, got {self.x_max!r}")
-        if self.y_max <= self.island_radius:
-            raise ValueError(f"y_max: must be > island_radius, got {self.y_max!r}")
 
-    @property
-    def y_min(self) -> float:
-        """Lower y edge of the mesh: 0 for a half domain, else ``-y_max``."""
-        return 0.0 if self.symmetric else -self.y_max
+    @classmethod
+    def of(cls, box: DomainBox, a: float) -> "Geometry":
+        """The metrics' geometry of a domain box and a contact radius [m]."""
+        return cls(**box.fields(), a=a)
 
 
 @dataclass(frozen=True, eq=False)

@@ -165,8 +165,7 @@ class Sample:
 
 
 def pattern_geometry(geom: CaseGeometry) -> metrics.Geometry:
-    return metrics.Geometry(a=geom.a, island_radius=geom.island_radius, x_min=geom.x_min,
-                            x_max=geom.x_max, y_max=geom.y_max, symmetric=geom.symmetric)
+    return metrics.Geometry.of(geom.box, geom.a)
 
 
 def _read_alpha(path: Path, structure: Structure) -> tuple[np.ndarray, FoamFieldFile]:

@@ -10,7 +10,7 @@ from ehlfoam.spec.case import SOLVERS, CaseSpec, load_case_spec, make_case_spec
 from ehlfoam.spec.levels import (FOLLOW_BASE, FOLLOW_LEVELS, FOLLOW_POLAR_RADIUS,
                                  POLAR_RING_SHARE, RESOLUTIONS)
 from ehlfoam.spec.mesh import Follow, Mesh, RefineBand, RefineBox, SideBox
-from ehlfoam.spec.sections import Domain, Physics, Run, Supply
+from ehlfoam.spec.sections import Domain, DomainBox, Physics, Run, Supply
 
 __all__ = [
     "FOLLOW_BASE",
@@ -21,6 +21,7 @@ __all__ = [
     "SOLVERS",
     "CaseSpec",
     "Domain",
+    "DomainBox",
     "Follow",
     "Mesh",
     "Physics",

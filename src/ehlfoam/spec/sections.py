@@ -8,8 +8,12 @@ degrees.
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 from typing import Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 #: Every table of a spec: unknown keys are refused, values frozen, NaN and inf refused.
@@ -155,6 +159,59 @@ class Physics(BaseModel):
                     "mineral oils). The run reports its gas release against it.")
 
 
+@dataclass(frozen=True)
+class DomainBox:
+    """The meshed domain around the contact in metres: the one record of its rectangle, which
+    the mesh (:class:`ehlfoam.mesh.MeshParams`), the flow-pattern metrics
+    (:class:`ehlfoam.metrics.raster.Geometry`) and a written case
+    (:attr:`ehlfoam.case.geometry.CaseGeometry.box`) extend or give.
+
+    ``x_min <= x <= x_max`` (x the rolling direction, the inlet at x_min) and ``0 <= y <=
+    y_max`` (``symmetric``: a half domain with a symmetry plane at y = 0) or ``|y| <= y_max``,
+    minus the island, the hole of radius ``island_radius`` [m] at the origin, which must lie
+    strictly inside. :meth:`Domain.box` makes it from the spec's domain (units of a)."""
+
+    x_min: float
+    x_max: float
+    y_max: float
+    island_radius: float
+    symmetric: bool = True
+
+    def __post_init__(self) -> None:
+        for name in ("x_min", "x_max", "y_max", "island_radius"):
+            value = getattr(self, name)
+            if (isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating))
+                    or not math.isfinite(value)):
+                raise ValueError(f"{name} must be a finite number in metres, got {value!r}")
+        r = float(self.island_radius)
+        if r <= 0:
+            raise ValueError(f"island_radius must be > 0 m, got {self.island_radius!r}")
+        for name, ok in (("x_min", self.x_min < -r), ("x_max", self.x_max > r),
+                         ("y_max", self.y_max > r)):
+            if not ok:
+                bound = "< -island_radius" if name == "x_min" else "> island_radius"
+                raise ValueError(f"{name} must be {bound} = {r:.6g} m (the island must lie "
+                                 f"inside the rectangle), got {name} = {getattr(self, name)!r}")
+        if not isinstance(self.symmetric, (bool, np.bool_)):
+            raise ValueError(f"symmetric must be True or False, got {self.symmetric!r}")
+
+    @property
+    def y_min(self) -> float:
+        """Lower y bound of the domain [m]: 0 (half domain) or -y_max."""
+        return 0.0 if self.symmetric else -float(self.y_max)
+
+    @property
+    def area(self) -> float:
+        """Area of the domain [m^2]: the rectangle minus the (half) island."""
+        hole = math.pi * self.island_radius**2 * (0.5 if self.symmetric else 1.0)
+        return (self.x_max - self.x_min) * (self.y_max - self.y_min) - hole
+
+    def fields(self) -> dict[str, float | bool]:
+        """Its fields by name, to build a record that extends it."""
+        return {"x_min": self.x_min, "x_max": self.x_max, "y_max": self.y_max,
+                "island_radius": self.island_radius, "symmetric": self.symmetric}
+
+
 class Domain(BaseModel):
     """Extents of the meshed domain around the contact centre."""
 
@@ -191,6 +248,12 @@ class Domain(BaseModel):
             raise ValueError(f"island_radius = {self.island_radius:g} a must stay below 0.8 x "
                              f"the nearest boundary ({0.8 * limit:g} a)")
         return self
+
+    def box(self, a: float) -> DomainBox:
+        """This domain in metres, for the Hertzian radius ``a`` [m]."""
+        return DomainBox(x_min=-self.upstream * a, x_max=self.downstream * a,
+                         y_max=self.side * a, island_radius=self.island_radius * a,
+                         symmetric=self.symmetry == "half")
 
 
 class Run(BaseModel):
