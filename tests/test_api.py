@@ -19,6 +19,7 @@ from tests.tiny import SMALL
 ROOT = Path(__file__).resolve().parents[1]
 
 
+@pytest.mark.openfoam
 def test_the_api_example_writes_runs_and_reads_a_case(tmp_path):
     proc = subprocess.run([sys.executable, str(ROOT / "examples" / "api.py"), str(tmp_path)],
                           capture_output=True, text=True, timeout=300, cwd=tmp_path)

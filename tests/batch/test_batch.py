@@ -133,6 +133,7 @@ def test_parser_registration_and_dry_run(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------ a local batch
+@pytest.mark.openfoam
 def test_batch_layout_and_results(tiny):
     spec, outcome = tiny
     batch = outcome.batch_dir
@@ -174,6 +175,7 @@ def test_batch_layout_and_results(tiny):
     assert regime["ramps"][0]["up"]["contact.speed"] == [0.01, 0.02]
 
 
+@pytest.mark.openfoam
 def test_ramp_step_starts_from_the_previous_final_fields(tiny):
     batch = tiny[1].batch_dir / CASES
     down, up = batch / RAMP[2], batch / RAMP[1]
@@ -198,6 +200,7 @@ def test_ramp_step_starts_from_the_previous_final_fields(tiny):
     assert first["oil_volume_m3"] == fresh["oil_volume_m3"]
 
 
+@pytest.mark.openfoam
 def test_ramp_start_on_another_mesh_is_interpolated(tiny, tmp_path):
     previous = tiny[1].batch_dir / CASES / RAMP[1]
     case = tmp_path / "finer"
@@ -215,6 +218,7 @@ def test_ramp_start_on_another_mesh_is_interpolated(tiny, tmp_path):
     assert seeded == pytest.approx(final, rel=1e-6, abs=0)
 
 
+@pytest.mark.openfoam
 def test_ramp_starts_from_a_run_case(tiny, tmp_path, capsys):
     """``start_from``: the ramp's first step starts from a case that ran elsewhere (here a
     finished step of the tiny batch), not from the puddle; a folder that has not run is
@@ -238,6 +242,7 @@ def test_ramp_starts_from_a_run_case(tiny, tmp_path, capsys):
         json.loads((source / "metrics.json").read_text())["oil_volume_m3"], rel=1e-3, abs=0)
 
 
+@pytest.mark.openfoam
 def test_ramp_steps_with_mesh_follow_follow_the_meniscus_they_start_from(tiny, tmp_path):
     """With ``mesh.follow`` every ramp step's mesh has bands along the meniscus of what it
     starts from (start_from, then the step before), and its written spec keeps them."""
@@ -259,6 +264,7 @@ def test_ramp_steps_with_mesh_follow_follow_the_meniscus_they_start_from(tiny, t
         assert json.loads((case / "metrics.json").read_text())["status"] == "finished"
 
 
+@pytest.mark.openfoam
 def test_rerun_keeps_finished_and_failed_cases(tiny):
     spec, outcome = tiny
     before = _mtimes(outcome.batch_dir)
@@ -291,6 +297,7 @@ def test_failed_ramp_step_leaves_the_later_steps_pending(tmp_path):
         ["failed", "pending", "pending"]
 
 
+@pytest.mark.openfoam
 def test_finished_case_with_another_spec_is_refused(tiny, tmp_path):
     spec, outcome = tiny
     changed = _spec(tmp_path, "tiny", spec.read_text().replace("end_time = 1e-3",
@@ -303,6 +310,7 @@ def test_finished_case_with_another_spec_is_refused(tiny, tmp_path):
 
 
 # ------------------------------------------------------------------ the Dask path
+@pytest.mark.slow
 def test_dask_local_cluster_gives_the_same_results(tiny, tmp_path):
     from distributed import Client, LocalCluster
 
@@ -409,6 +417,7 @@ def _gone(pids: list[int], batch: Path, timeout: float = 60.0) -> bool:
     return False
 
 
+@pytest.mark.openfoam
 def test_interrupt_kill_and_resume(tmp_path):
     """Ctrl-C, then SIGKILL of the batch process, each after a case finished; the re-runs
     never recompute a finished case and results.csv keeps one row per case."""

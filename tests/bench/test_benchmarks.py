@@ -70,6 +70,7 @@ def test_precalc_validation_meets_hertz_and_nvm(tmp_path):
     assert len(table_rows(stdout, "M   L  grid")) == 4
 
 
+@pytest.mark.openfoam
 def test_case_cost_tabulates_two_levels(tmp_path):
     stdout, rec = run_bench("case_cost", tmp_path)
     coarse, medium = rec["rows"]
@@ -83,6 +84,7 @@ def test_case_cost_tabulates_two_levels(tmp_path):
         assert r["solver_cpu_s"] > 0 and r["wall_s"] > 0
 
 
+@pytest.mark.openfoam
 @pytest.mark.slow
 def test_single_phase_check_meets_reynolds(tmp_path):
     stdout, rec = run_bench("single_phase_check", tmp_path)
@@ -93,6 +95,7 @@ def test_single_phase_check_meets_reynolds(tmp_path):
     assert table_rows(stdout, "level  cells")[0][0] == "coarse"
 
 
+@pytest.mark.openfoam
 @pytest.mark.slow
 def test_batch_cost_runs_the_same_batch_twice_alike_and_reports_it(tmp_path):
     stdout, rec = run_bench("batch_cost", tmp_path)
@@ -106,6 +109,7 @@ def test_batch_cost_runs_the_same_batch_twice_alike_and_reports_it(tmp_path):
     assert "local vs one at a time: same cases, states and steps: True" in stdout
 
 
+@pytest.mark.openfoam
 def test_strips_lay_films_near_landau_levich_and_hold_a_contact_line(tmp_path):
     stdout, rec = run_bench("strips", tmp_path)
     (films,) = rec["films"]

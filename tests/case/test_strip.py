@@ -56,6 +56,7 @@ def test_cells_finer_than_the_columns_lean_at_the_supply_stay_right_side_out():
     assert x[1] - x[0] > 1.5 * 0.035 * a                              # coarser at the supply
 
 
+@pytest.mark.openfoam
 def test_a_fed_bridge_runs_and_lays_films_behind_its_rear_meniscus(small, tmp_path):
     spec, gap, a = small
     mesh = strip_mesh(spec, gap, 3 * a, 10 * a, 0.5 * a)
@@ -74,6 +75,7 @@ def test_a_fed_bridge_runs_and_lays_films_behind_its_rear_meniscus(small, tmp_pa
     assert last["oil_per_width_m2"] > 0
 
 
+@pytest.mark.openfoam
 def test_dry_walls_run_into_a_bridge_fed_by_the_reservoir(small, tmp_path):
     spec, gap, a = small
     mesh = strip_mesh(spec, gap, 4 * a, 10 * a, 0.5 * a)
@@ -98,6 +100,7 @@ def test_dry_walls_run_into_a_bridge_fed_by_the_reservoir(small, tmp_path):
     assert oil[-1] < 0.05 * h[-1]               # the walls come in dry
 
 
+@pytest.mark.openfoam
 def test_slipping_walls_drag_the_bridge_less(small, tmp_path):
     """The same strip with a slip of 5 um on both walls (physics.wall_slip_length): the walls
     are Navier-slip directionMixed walls at -u on every face, and over the same 0.02 s they drag

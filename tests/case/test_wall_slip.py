@@ -59,6 +59,7 @@ def test_spec_refuses_a_slip_beyond_its_range():
         make_case_spec({**SMALL, "physics": {"wall_slip_length": 1e-3}})
 
 
+@pytest.mark.openfoam
 def test_solver_holds_the_walls_fluid_at_the_navier_slip(slip_case, tmp_path):
     """After 1 ms of the single-phase flow, every disc and ball face's written velocity is the
     wall's plus (1 - f) of its cell's tangential velocity relative to the wall, and none

@@ -320,6 +320,7 @@ def test_ehlfoam_band_follows_a_written_meniscus(small_case, tmp_path):
     assert bad.returncode == 2 and "--half-width = -1 a is out of range" in bad.stderr
 
 
+@pytest.mark.openfoam
 def test_allrun_runs_by_hand(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:
@@ -333,6 +334,7 @@ def test_allrun_runs_by_hand(small_case, tmp_path):
     assert not (case / "0.0002").exists() and (case / "0.orig").is_dir()
 
 
+@pytest.mark.openfoam
 def test_checkmesh_passes(small_case):
     log = FoamRuntime.from_environment().run("checkMesh", [], cwd=small_case).stdout
     assert "Mesh OK." in log, log[-2000:]
@@ -370,6 +372,7 @@ def test_supply_enters_only_on_the_track(small_case):
     assert np.allclose(np.asarray(u, float), [0.02, 0.0, 0.0])
 
 
+@pytest.mark.openfoam
 def test_supply_carries_the_layers_in(small_case, tmp_path):
     """The oil entering per second is u x (disc + ball layer) x track width."""
     from ehlfoam.run import fields as case_fields
@@ -413,6 +416,7 @@ def test_thin_wall_cells_under_a_sloping_ball_carry_the_whole_supply_in(tmp_path
     assert flux == pytest.approx(spec.speed * (3e-6 + 3e-6) * 2 * 2.5e-4, rel=1e-6)
 
 
+@pytest.mark.openfoam
 def test_side_bands_carry_their_layers_in(tmp_path):
     """With a dry middle band the oil enters only on |y| in [inner, outer]: the flux is
     u x (disc + ball layer) x 2 (outer - inner), and no supply face lies inside the band."""
@@ -444,6 +448,7 @@ def test_side_bands_carry_their_layers_in(tmp_path):
     assert s.oil_in == pytest.approx(0.02 * (3e-6 + 3e-6) * 2 * (2.5e-4 - inner), rel=0.05)
 
 
+@pytest.mark.openfoam
 def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     m = run_case(case, wall_limit=120)
@@ -488,6 +493,7 @@ def test_run_a_few_steps_writes_metrics(small_case, tmp_path):
     assert saved["end_reason"] == "end_time" and saved["time_steps"] == m["time_steps"]
 
 
+@pytest.mark.openfoam
 def test_polar_ring_case_builds_and_runs(tmp_path):
     """mesh.polar_radius reaches the mesh (column centres on a few circles around the island),
     checkMesh passes and the solver runs on it."""
@@ -506,6 +512,7 @@ def test_polar_ring_case_builds_and_runs(tmp_path):
     assert m["oil_mass_balance_error"] < 0.1
 
 
+@pytest.mark.openfoam
 @pytest.mark.parametrize("scene", ["interface", "cavitating", "gas-release"])
 def test_balanced_interface_schemes_reach_every_solver(tmp_path, scene):
     """physics.interface_schemes = "balanced" writes uncorrected face gradients, the
@@ -532,6 +539,7 @@ def test_balanced_interface_schemes_reach_every_solver(tmp_path, scene):
         assert "nHat" not in f["gradSchemes"]
 
 
+@pytest.mark.openfoam
 def test_cavitating_case_runs_a_few_steps(tmp_path):
     """The cavitating scene (compressibleInterFoam, air a perfect gas, absolute pressure):
     builds, runs, and reports the bubble and the lowest pressure."""
@@ -559,6 +567,7 @@ def test_cavitating_case_runs_a_few_steps(tmp_path):
     assert "bubble_volume_m3" in header and "min_pressure_Pa" in header
 
 
+@pytest.mark.openfoam
 def test_cavitating_case_with_a_compressible_oil(tmp_path):
     """physics.oil_bulk_modulus makes the oil a perfect fluid, R = K/(rho0 T), which the
     solver reads and runs."""
@@ -575,6 +584,7 @@ def test_cavitating_case_with_a_compressible_oil(tmp_path):
     assert m["status"] == "finished" and m["end_reason"] == "end_time", m
 
 
+@pytest.mark.openfoam
 def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
     """The gas-release scene (interPhaseChangeFoam, Kunz's vaporisation term only, no
     condensation): oil below the release pressure turns into gas, so the suction behind the
@@ -614,6 +624,7 @@ def test_gas_release_case_holds_the_pressure_at_the_release_pressure(tmp_path):
     assert u_supply.ndim == 2 and np.all(u_supply[:, 0] < spec.wall_speed)
 
 
+@pytest.mark.openfoam
 def test_submerged_gas_release_dissolves_its_gas_back(tmp_path):
     """A submerged contact (supply.mode = "submerged": oil fills the domain and is what
     flows in everywhere) in the gas-release scene: the only gas is what the suction
@@ -665,6 +676,7 @@ def _last_velocity(case: Path) -> np.ndarray:
     return np.asarray(FoamFieldFile(last / "U").internal_field)
 
 
+@pytest.mark.openfoam
 def test_gas_release_flow_does_not_remember_the_initial_air(tmp_path):
     """interPhaseChangeFoam v1912 computes the mixture viscosity once, from the initial oil
     fraction, and never again. Here oil fills the gap and enters everywhere, so the flow must
@@ -693,6 +705,7 @@ def test_gas_release_flow_does_not_remember_the_initial_air(tmp_path):
     assert np.abs(velocities[0.0] - velocities[1.0]).max() < 1e-3 * spec.wall_speed
 
 
+@pytest.mark.openfoam
 def test_cavitating_case_starts_from_another_cases_fields(tmp_path):
     """A ramp step of the cavitating scene: the previous case's final fields (lists, p and T
     included) as the start; the case must read them (no $internalField in list fields)."""
@@ -720,6 +733,7 @@ def _toml(spec: dict) -> str:
     return "\n".join(top + tables) + "\n"
 
 
+@pytest.mark.openfoam
 def test_cli_case_starts_from_another_run_case(tmp_path):
     """`ehlfoam case --start-from CASE`: the new case's initial fields are CASE's final ones
     (a converged neighbour); a CASE with nothing written is refused before anything is."""
@@ -748,6 +762,7 @@ def test_cli_case_starts_from_another_run_case(tmp_path):
         start, case_fields._read_alpha(first / "0.orig" / "alpha.oil", structure)[0])
 
 
+@pytest.mark.openfoam
 def test_cli_snapshot_keeps_a_runs_state_and_starts_another_case_from_it(tmp_path):
     """`ehlfoam snapshot CASE OUT.npz`: a run's last write in one small file; `ehlfoam case
     --start-from OUT.npz` gives a case on the same mesh that write's oil and velocity back
@@ -899,6 +914,7 @@ def test_cli_case_starts_from_a_thin_film_state(small_case, tmp_path):
     assert len(near_axis) >= 3 and np.abs(near_axis[:, 0] - 1.0).max() < 0.3
 
 
+@pytest.mark.openfoam
 def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path):
     """Thinner wall cells under the same in-plane cells make the ball stair-step over many
     wall-cell heights per cell, where a spurious film creeps along it: `ehlfoam case` says so
@@ -936,6 +952,7 @@ def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path)
     assert front_cell_warnings(m["front_contact_line_cells_over_wall_cell"], 0.5)
 
 
+@pytest.mark.openfoam
 def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:   # a fixed, absurd time step
@@ -950,6 +967,7 @@ def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
     assert saved["status"] == "failed"
 
 
+@pytest.mark.openfoam
 def test_static_meniscus_stays_put(tmp_path):
     """Walls at rest, no supply, a puddle around the island, default settings (the polar
     ring, cAlpha 1): the meniscus stays where it started, the oil volume holds, and the
@@ -996,6 +1014,7 @@ QUIET_STATICS = {
 }
 
 
+@pytest.mark.openfoam
 @pytest.mark.parametrize("config", list(QUIET_STATICS))
 def test_static_meniscus_moves_less_than_1_percent_of_u_with_balanced_schemes(tmp_path, config):
     """Where the issue's 1 % holds at the default compression (cAlpha 1), here on the coarse
@@ -1034,6 +1053,7 @@ def test_static_meniscus_moves_less_than_1_percent_of_u_with_balanced_schemes(tm
     assert m["oil_volume_m3"] == pytest.approx(m["oil_volume_initial_m3"], rel=1e-3)
 
 
+@pytest.mark.openfoam
 @pytest.mark.skipif(os.geteuid() != 0 or shutil.which("unshare") is None,
                     reason="parallel runs of the embedded runtime need root and unshare")
 def test_parallel_run_matches_serial(small_case, tmp_path):
@@ -1053,6 +1073,7 @@ def test_parallel_run_matches_serial(small_case, tmp_path):
     assert m["oil_volume_m3"] == pytest.approx(s["oil_volume_m3"], rel=1e-3)
 
 
+@pytest.mark.openfoam
 @pytest.mark.skipif(os.geteuid() != 0 or shutil.which("unshare") is None,
                     reason="parallel runs of the embedded runtime need root and unshare")
 def test_parallel_restart_decomposes_its_latest_time_only(tmp_path):
@@ -1078,6 +1099,7 @@ def test_parallel_restart_decomposes_its_latest_time_only(tmp_path):
     assert history[0] == pytest.approx(before[0]) and history[-1] >= 4e-4 * (1 - 1e-6)
 
 
+@pytest.mark.openfoam
 def test_stopped_run_samples_its_last_writes(tmp_path):
     """SIGTERM stops a serial run through controlDict (writeNow); its history.csv still holds
     every time it wrote, the last one included, and it is marked interrupted, not failed."""
@@ -1099,6 +1121,7 @@ def test_stopped_run_samples_its_last_writes(tmp_path):
     assert list(read_history(case / "history.csv")["time_s"]) == pytest.approx(written)
 
 
+@pytest.mark.openfoam
 def test_full_domain_case_builds_and_runs(tmp_path):
     """symmetry = "full": both sides meshed, no symmetry patch, the same supply."""
     spec = make_case_spec({**SMALL, "domain": {**SMALL["domain"], "symmetry": "full"},
@@ -1116,6 +1139,7 @@ def test_full_domain_case_builds_and_runs(tmp_path):
     assert m["oil_inflow_m3_s"] == pytest.approx(0.02 * 6e-6 * 5e-4, rel=1e-6)
 
 
+@pytest.mark.openfoam
 def test_monitor_stops_a_steady_run(tmp_path):
     """A meniscus at rest is (nearly) steady: the monitor sees it hold still over one transit
     and stops the solver through controlDict before the time limit. The tolerance is loose
@@ -1141,6 +1165,7 @@ def test_monitor_stops_a_steady_run(tmp_path):
         run_case(case, extend_transits=0)
 
 
+@pytest.mark.openfoam
 def test_cli_run_prints_metrics_and_exit_code(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:
@@ -1163,6 +1188,7 @@ def test_cli_run_prints_metrics_and_exit_code(small_case, tmp_path):
     assert bad.returncode == 2 and "--extend" in bad.stderr and "> 0" in bad.stderr
 
 
+@pytest.mark.openfoam
 def test_single_phase_case_stays_oil(tmp_path):
     """The single-phase scene (oil everywhere, the Reynolds check): oil is what enters on
     every open boundary, the fixed upstream one included, so no air appears in 1 ms."""

@@ -33,6 +33,7 @@ def case(tmp_path) -> Path:
     return case
 
 
+@pytest.mark.openfoam
 def test_an_application_runs_in_the_case_given_by_dash_case_or_in_the_working_folder(case):
     named = ehlfoam("foam", "foamListTimes", "-case", str(case))
     assert named.returncode == 0, named.stderr
@@ -42,6 +43,7 @@ def test_an_application_runs_in_the_case_given_by_dash_case_or_in_the_working_fo
     assert here.stdout.split() == ["0", "0.5", "1"]
 
 
+@pytest.mark.openfoam
 def test_the_applications_exit_code_and_message_come_through(tmp_path):
     proc = ehlfoam("foam", "checkMesh", cwd=tmp_path)      # no system/controlDict
     assert proc.returncode == 1
@@ -49,6 +51,7 @@ def test_the_applications_exit_code_and_message_come_through(tmp_path):
     assert "system/controlDict" in proc.stdout + proc.stderr
 
 
+@pytest.mark.openfoam
 @pytest.mark.parametrize("app", ["../bin/checkMesh", "/usr/bin/checkMesh", "check Mesh",
                                  "checkMesh;ls", "$(ls)"])
 def test_only_a_plain_application_name_is_run(app, tmp_path):
@@ -58,6 +61,7 @@ def test_only_a_plain_application_name_is_run(app, tmp_path):
     assert not any(tmp_path.iterdir())
 
 
+@pytest.mark.openfoam
 def test_an_application_the_runtime_lacks_is_refused_with_the_way_to_list_them():
     near = ehlfoam("foam", "checkMesch")
     assert near.returncode == 2, near.stderr

@@ -14,6 +14,8 @@ import pytest
 from ehlfoam.notices import from_text
 from tests.tiny import SMALL
 
+pytestmark = pytest.mark.openfoam   # every test here runs OpenFOAM
+
 EHLFOAM = [str(Path(sys.executable).parent / "ehlfoam")]
 
 

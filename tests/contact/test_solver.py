@@ -126,6 +126,7 @@ def test_high_pressure_viscosity_light_load_converges():
     assert 0 < s["hmin_m"] < s["hc_m"]
 
 
+@pytest.mark.slow
 def test_stalled_large_L_solve_switches_relaxation_and_converges():
     """M = 100, L = 20 on 513^2 (alpha pH ~ 34): the standard cycles fall into a limit
     cycle at a residual of ~2e-4 where the spike's side lobes end; the stalled-solve

@@ -298,6 +298,7 @@ def test_write_polymesh_files(coarse: PolyMesh, tmp_path: Path) -> None:
     assert first == "4(%d %d %d %d)" % tuple(coarse.faces[0])
 
 
+@pytest.mark.openfoam
 def test_checkmesh_ok_on_realistic_mesh(reference: PolyMesh, runtime: FoamRuntime,
                                         tmp_path: Path) -> None:
     case = write_case(reference, tmp_path / "reference")
@@ -306,6 +307,7 @@ def test_checkmesh_ok_on_realistic_mesh(reference: PolyMesh, runtime: FoamRuntim
     assert stats["total_volume"] == pytest.approx(reference.cell_volumes.sum(), rel=1e-5)
 
 
+@pytest.mark.openfoam
 def test_full_domain_is_the_half_mirrored(coarse: PolyMesh, coarse_base: BaseMesh,
                                            runtime: FoamRuntime, tmp_path: Path) -> None:
     p_full = params(symmetric=False)
@@ -328,6 +330,7 @@ def test_full_domain_is_the_half_mirrored(coarse: PolyMesh, coarse_base: BaseMes
     check_mesh(runtime, write_case(full, tmp_path / "full"))
 
 
+@pytest.mark.openfoam
 def test_full_domain_with_uneven_size_is_meshed_whole(runtime: FoamRuntime,
                                                       tmp_path: Path) -> None:
     p_full = params(symmetric=False)
@@ -344,6 +347,7 @@ def test_full_domain_with_uneven_size_is_meshed_whole(runtime: FoamRuntime,
     check_mesh(runtime, write_case(full, tmp_path / "uneven"))
 
 
+@pytest.mark.openfoam
 def test_polar_ring_is_log_polar_and_the_rest_is_free(runtime: FoamRuntime,
                                                        tmp_path: Path) -> None:
     r_polar = 4 * A_HERTZ

@@ -80,6 +80,7 @@ def _png(path: Path) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ the case report
+@pytest.mark.openfoam
 def test_case_report_has_every_part(case_report, finished_case):
     index, _ = case_report
     assert index == finished_case / "report" / "index.html"
@@ -104,6 +105,7 @@ def test_case_report_has_every_part(case_report, finished_case):
     # (its cost is timed elsewhere, not asserted here)
 
 
+@pytest.mark.openfoam
 def test_top_view_meniscus_lies_where_the_metrics_say(case_report, finished_case):
     """Along y = 0 upstream of the island the PNG's black meniscus line is at
     x = -(1 + inlet_meniscus_distance_over_a) a, within two pixels."""
@@ -127,6 +129,7 @@ def test_top_view_meniscus_lies_where_the_metrics_say(case_report, finished_case
     assert abs(x_png - x_expected) <= 2.0 / sx * 1e-3, (x_png / geom.a, x_expected / geom.a)
 
 
+@pytest.mark.openfoam
 def test_top_view_oil_and_air_colours(case_report, finished_case):
     """A pixel inside the puddle (oil in the raster) has the oil colour, one in the far
     corner (air) the air colour."""
@@ -152,6 +155,7 @@ def test_top_view_oil_and_air_colours(case_report, finished_case):
     check(geom.x_max - 0.6 * geom.a, geom.y_max - 1.5 * geom.a, AIR_RGB, (0.0, 0.01))
 
 
+@pytest.mark.openfoam
 def test_side_view_gap_grows_away_from_the_contact(finished_case):
     geom = load_geometry(finished_case)
     cut = cut_at_axis(load_fields(finished_case, geom))
@@ -165,6 +169,7 @@ def test_side_view_gap_grows_away_from_the_contact(finished_case):
     assert np.all((cut.alpha >= 0) & (cut.alpha <= 1)) and len(cut.triangles) > 50
 
 
+@pytest.mark.openfoam
 def test_failed_case_says_so_with_the_log_tail(finished_case, tmp_path):
     case = _failed_copy(finished_case, tmp_path / "failed")
     index = report_case(case, animate=False)
@@ -177,6 +182,7 @@ def test_failed_case_says_so_with_the_log_tail(finished_case, tmp_path):
     assert thumb[5, 5, 0] > 150 and thumb[5, 5, 1] < 80        # the red FAILED stamp
 
 
+@pytest.mark.openfoam
 def test_running_and_never_run_cases(finished_case, tmp_path):
     running = _copy(finished_case, tmp_path / "running")
     (running / "metrics.json").write_text(json.dumps({"status": "running", "cells": 1}))
@@ -194,6 +200,7 @@ def test_running_and_never_run_cases(finished_case, tmp_path):
     assert "What could not be shown" not in html
 
 
+@pytest.mark.openfoam
 def test_broken_case_reports_problems_instead_of_crashing(finished_case, tmp_path):
     case = _copy(finished_case, tmp_path / "broken")
     last = time_folders(case)[-1][1]
@@ -207,6 +214,7 @@ def test_broken_case_reports_problems_instead_of_crashing(finished_case, tmp_pat
     assert info["fields_time_s"] < float(last.name)
 
 
+@pytest.mark.openfoam
 def test_report_detects_case_and_batch_and_bad_input(finished_case, tmp_path):
     with pytest.raises(FileNotFoundError):
         report(tmp_path / "nowhere")
@@ -221,6 +229,7 @@ def test_report_detects_case_and_batch_and_bad_input(finished_case, tmp_path):
     assert args.func(args) == 2
 
 
+@pytest.mark.openfoam
 def test_cli_module_off_screen(finished_case, tmp_path):
     """``python -m ehlfoam report CASE`` in a process with no display at all."""
     case = _copy(finished_case, tmp_path / "cli")
@@ -275,6 +284,7 @@ def batch(finished_case, case_report, tmp_path_factory) -> Path:
     return root
 
 
+@pytest.mark.openfoam
 def test_batch_report_index_failures_and_reuse(batch):
     before = (batch / "cases" / "ok" / "report" / "report.json").stat().st_mtime
     index = report_batch(batch, jobs=1)
@@ -342,6 +352,7 @@ def _loaded_images(page: Path, tmp_path: Path) -> tuple[int, int]:
     return int(loaded.group(1)), int(total.group(1))
 
 
+@pytest.mark.openfoam
 def test_pages_load_every_image_in_chromium(case_report, batch, tmp_path):
     index, _ = case_report
     loaded, total = _loaded_images(index, tmp_path)
@@ -353,6 +364,7 @@ def test_pages_load_every_image_in_chromium(case_report, batch, tmp_path):
     assert total >= 3 and loaded == total
 
 
+@pytest.mark.openfoam
 def test_browser_check_sees_a_missing_image(case_report, tmp_path):
     """The counter is not a formality: a page with a broken link counts one image short."""
     index, _ = case_report
@@ -365,6 +377,7 @@ def test_browser_check_sees_a_missing_image(case_report, tmp_path):
     assert loaded == total - 1
 
 
+@pytest.mark.openfoam
 def test_batch_report_reads_the_mesh_convergence_of_three_levels(finished_case, case_report,
                                                                   tmp_path):
     """Three copies of a real case, filed as coarse / medium / fine with far-field cells of
