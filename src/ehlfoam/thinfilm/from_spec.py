@@ -10,6 +10,12 @@ command line.
 
 Lengths of the grid (cell, domain, normal length) are given in units of the Hertzian radius
 a, as the case spec's own domain is; everything the model is handed is SI.
+
+The thin-film scene (``scene = "thin-film"``) takes its options from the spec itself
+(:func:`scene_options`: the spec's domain, its ``[thin_film]`` table and its level's cell),
+and every scene that makes gas (cavitating, gas-release, thin-film) its outlet: gas at
+``physics.cavitation_pressure`` where the oil would fall below it
+(:mod:`ehlfoam.thinfilm.cavity`).
 """
 
 from __future__ import annotations
@@ -23,12 +29,18 @@ import numpy as np
 
 from ehlfoam._io import atomic_write_json
 from ehlfoam.spec.case import CaseSpec
+from ehlfoam.spec.thin_film import thin_film_cell
 from ehlfoam.thinfilm.march import solve_thin_film
 from ehlfoam.thinfilm.problem import ThinFilmProblem
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import save_state
 
-__all__ = ["RegionOptions", "march", "problem_from_spec", "write_region"]
+__all__ = ["CAVITATING_SCENES", "RegionOptions", "cavitation_gauge", "march",
+           "problem_from_spec", "scene_options", "write_region"]
+
+#: The scenes whose oil gives up gas below physics.cavitation_pressure: their thin-film
+#: problems have the outlet model.
+CAVITATING_SCENES = ("cavitating", "gas-release", "thin-film")
 
 #: the files :func:`write_region` writes into its folder
 STATE_FILE, SUMMARY_FILE = "state.npz", "summary.json"
@@ -50,6 +62,8 @@ class RegionOptions:
             give the same region); None: 1.5 cells.
         meniscus_position: "sub-cell" (as far into its open cell as its oil fills it) or
             "cell" (at that cell's centre).
+        cavitation: the outlet model: gas at the spec's cavitation pressure where the oil
+            would fall below it; None: the spec's scene says (:data:`CAVITATING_SCENES`).
     """
 
     cell: float = 0.2
@@ -59,13 +73,31 @@ class RegionOptions:
     advancing_angle: float | None = None
     normal_length: float | None = 0.3
     meniscus_position: Literal["sub-cell", "cell"] = "sub-cell"
+    cavitation: bool | None = None
+
+
+def scene_options(spec: CaseSpec) -> RegionOptions:
+    """The options of ``scene = "thin-film"``: the spec's domain (its half: upstream,
+    downstream, side), its ``[thin_film]`` table, and its cell (``thin_film.cell`` or the
+    level's)."""
+    d, tf = spec.domain, spec.thin_film
+    return RegionOptions(cell=thin_film_cell(spec), domain=(-d.upstream, d.downstream, d.side),
+                         film_factor=tf.film_factor, receding=tf.receding_meniscus,
+                         advancing_angle=tf.advancing_angle, normal_length=tf.normal_length,
+                         cavitation=True)
+
+
+def cavitation_gauge(spec: CaseSpec) -> float:
+    """The cavitation pressure as the model takes it [Pa]: gauge, against ambient."""
+    return spec.physics.cavitation_pressure - spec.physics.ambient_pressure
 
 
 def problem_from_spec(spec: CaseSpec, gap: Callable[[np.ndarray, np.ndarray], np.ndarray],
                       options: RegionOptions = RegionOptions()) -> ThinFilmProblem:
     """The thin-film problem of a case spec on the gap h(x, y) [m]: its contact's speed, its
     oil, wetting and supply ("layers": both layers on the track; "flooded": the whole inlet
-    gap on the track), its island and initial puddle, gridded as ``options`` say.
+    gap on the track), its island and initial puddle, its cavitation pressure (the outlet
+    model, as ``options.cavitation`` or the scene says), gridded as ``options`` say.
 
     Raises ValueError naming the parameter, its value and the valid range: a supply mode the
     model has no counterpart of, or a cell, domain or angle out of the model's range."""
@@ -80,6 +112,15 @@ def problem_from_spec(spec: CaseSpec, gap: Callable[[np.ndarray, np.ndarray], np
     else:
         raise ValueError(f"supply.mode = {sup.mode!r}: the thin-film model takes 'layers' or "
                          "'flooded'")
+    cavitation = options.cavitation
+    if cavitation is None:
+        cavitation = spec.scene in CAVITATING_SCENES
+    p_cav = cavitation_gauge(spec) if cavitation else None
+    if p_cav is not None and not p_cav < 0:
+        raise ValueError(f"physics.cavitation_pressure = {spec.physics.cavitation_pressure:g} "
+                         f"Pa must be below physics.ambient_pressure = "
+                         f"{spec.physics.ambient_pressure:g} Pa (the oil gives up gas below "
+                         "ambient)")
     return ThinFilmProblem(
         gap=gap, speed=spec.speed, viscosity=spec.oil_viscosity,
         surface_tension=spec.physics.surface_tension, contact_angle=spec.physics.contact_angle,
@@ -89,7 +130,8 @@ def problem_from_spec(spec: CaseSpec, gap: Callable[[np.ndarray, np.ndarray], np
         initial_radius=sup.initial_puddle * a, film_factor=options.film_factor,
         receding_meniscus=options.receding,
         normal_length=None if options.normal_length is None else options.normal_length * a,
-        advancing_angle=options.advancing_angle, meniscus_position=options.meniscus_position)
+        advancing_angle=options.advancing_angle, meniscus_position=options.meniscus_position,
+        cavitation_pressure=p_cav)
 
 
 def _check_grid(options: RegionOptions, island: float) -> None:

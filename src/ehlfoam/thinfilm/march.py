@@ -42,6 +42,11 @@ cell at a time). The nominal problem has two balanced states, reached from above
 puddle: 170.1 and 161.4 nl, 15.80 and 15.55 a wide on 0.05 a cells
 (docs/models/thin-film.md#what-it-gives-the-nominal-case-8-mms-8-um-layers).
 
+With a cavitation pressure (``cavitation_pressure``, gauge) the model has an outlet: a
+flooded cell whose pressure would fall below it opens to gas, the gas the flooded region
+encloses (a cavity, the bubble behind the contact) is at it, and the walls carry the oil of
+a cavity's cells, their film content, on at u, all of it (:mod:`ehlfoam.thinfilm.cavity`).
+
 This is the mass-conserving cavitation model of lubrication (Elrod-Adams; Jakobsson,
 Floberg and Olsson's conditions) with two changes that make it a model of this flow: the
 boundary pressure is the meniscus's Young-Laplace pressure instead of a cavitation pressure,
@@ -68,6 +73,129 @@ from ehlfoam.thinfilm.operators import Operators
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 from ehlfoam.thinfilm.solution import ThinFilmSolution, connected_region, oil_fraction_on
 
+__all__ = ["Marcher", "solve_thin_film"]
+
+
+class Marcher:
+    """A march of one problem, a step at a time, for a caller that decides when to stop (the
+    run of a thin-film case, :mod:`ehlfoam.run.thin_film`; :func:`solve_thin_film` is the
+    march to a balance). ``start``: a solution (on any grid) whose oil fractions replace the
+    initial puddle; ``courant``: the step over a cell's transit at u; ``transit_length``
+    [m]: the length whose transit at u is one record of :attr:`history` (by default the
+    domain's length).
+
+    It keeps the oil in the domain exactly: the supply it took in and what left through the
+    outlet and the side since its start [m3, half domain] (:attr:`oil_in`,
+    :attr:`oil_out_outlet`, :attr:`oil_out_side`), step by step."""
+
+    def __init__(self, prob: ThinFilmProblem, *, start: ThinFilmSolution | None = None,
+                 courant: float = 0.25, transit_length: float | None = None):
+        if not 0 < courant <= 1:
+            raise ValueError(f"courant = {courant!r} is out of range: must be in (0, 1]")
+        self.prob = prob
+        self.grid = grid = Grid.build(prob)
+        self.ops = Operators(prob, grid)
+        self.h = h = np.nan_to_num(grid.h)
+        d, u = grid.cell, prob.speed
+        if start is None:
+            X, Y = np.meshgrid(grid.x, grid.y)
+            self.c = np.where((np.hypot(X, Y) < prob.initial_radius) & ~grid.island, h, 0.0)
+        else:   # a full cell may hold more: it returns it
+            self.c = oil_fraction_on(start, grid) * h
+        self.dt = courant * d / u
+        self.transit = (transit_length or (prob.x_range[1] - prob.x_range[0])) / u
+        self.steps_per_transit = max(1, int(round(self.transit / self.dt)))
+        self.q_in = float(self.ops.q_supply.sum())
+        self.oil_start = self.oil()
+        self.oil_in = self.oil_out_outlet = self.oil_out_side = 0.0
+        self.flooded = (self.c >= h * (1.0 - 1e-9)) & ~grid.island
+        self.p = np.full(self.c.shape, np.nan)
+        self.steps = 0
+        self.history: list[dict] = []
+        self._out = self._dry = self._cavitated = 0.0
+
+    @property
+    def time(self) -> float:
+        """Time marched [s]."""
+        return self.steps * self.dt
+
+    def oil(self) -> float:
+        """The oil in the domain [m3, half domain]: every cell's content."""
+        return float(self.c.sum()) * self.grid.cell ** 2
+
+    def step(self) -> None:
+        """One step; a transit's record is added to :attr:`history` after each
+        ``steps_per_transit`` steps."""
+        s = self.ops.step(self.flooded, self.c, self.dt)
+        self.c = self.c + s.dc
+        self.flooded = ((self.c >= self.h * (1.0 - 1e-9)) & ~s.opened & ~s.cavitated
+                        & ~self.grid.island)
+        self.p = s.p
+        self.steps += 1
+        self.oil_in += self.q_in * self.dt
+        self.oil_out_outlet += s.q_outlet * self.dt
+        self.oil_out_side += s.q_side * self.dt
+        self._out += (s.q_outlet + s.q_side) * self.dt
+        self._dry += int(s.opened.sum())
+        self._cavitated += int(s.cavitated.sum())
+        if self.steps % self.steps_per_transit == 0:
+            self.history.append(self._record())
+
+    def _record(self) -> dict:
+        """The transit just marched: its time [s], the region's oil [m3, half domain], its
+        flooded cells, outflow over supply, width [m], the flooded cells that ran dry within
+        a step and those that opened to gas, and the cavities' cells now."""
+        grid, d = self.grid, self.grid.cell
+        region = connected_region(self.flooded, grid.island)
+        rows = np.nonzero(region.any(axis=1))[0]
+        rec = {"time_s": self.time,
+               "oil_m3": float(np.sum(np.where(region, self.h, 0.0))) * d * d,
+               "flooded_cells": int(region.sum()),
+               "outflow_over_supply": self._out / (self.q_in * self.steps_per_transit
+                                                   * self.dt) if self.q_in > 0 else 0.0,
+               "width_m": float(2 * (grid.y[rows[-1]] + d / 2)) if rows.size else 0.0,
+               "cells_opened_dry": int(self._dry),
+               "cells_opened_to_gas": int(self._cavitated),
+               "cavity_cells": int(self.cavity().sum())}
+        self._out = self._dry = self._cavitated = 0.0
+        return rec
+
+    def cavity(self) -> np.ndarray:
+        """The open cells the flooded region encloses now, at the cavitation pressure (none
+        without one)."""
+        return self.ops.cavities(self.flooded)
+
+    def balanced(self, tolerance: float, window: int) -> bool:
+        """Over the last ``window`` transits the mean outflow is within ``tolerance`` of the
+        supply and the region's oil changed by less than ``tolerance`` of itself."""
+        h = self.history
+        if tolerance <= 0 or len(h) <= window:
+            return False
+        change = abs(h[-1]["oil_m3"] - h[-1 - window]["oil_m3"])
+        out = np.mean([r["outflow_over_supply"] for r in h[-window:]])
+        return change <= tolerance * h[-1]["oil_m3"] and abs(out - 1.0) <= tolerance
+
+    def mass_balance_error(self) -> float:
+        """The oil gained less what came in and went out since the start, over what came in
+        (round-off: the model conserves the oil); 0 before anything came in."""
+        residual = self.oil() - self.oil_start - self.oil_in + self.oil_out_outlet \
+            + self.oil_out_side
+        return abs(residual) / self.oil_in if self.oil_in > 0 else 0.0
+
+    def solution(self, steady: bool = False) -> ThinFilmSolution:
+        """The state now, as a :class:`ThinFilmSolution`."""
+        h = self.history
+        cavity = self.cavity()
+        return ThinFilmSolution(
+            grid=self.grid, p=np.where(self.flooded, self.p, np.nan), content=self.c,
+            flooded=self.flooded, time=self.time, steps=self.steps, flux_in=self.q_in,
+            flux_out=h[-1]["outflow_over_supply"] * self.q_in if h else 0.0,
+            steady=steady, island_radius=self.prob.island_radius, history=list(h),
+            mass_balance_error=self.mass_balance_error(),
+            fill=np.where(self.flooded, 0.0, self.ops.fill(self.c, cavity))
+            if self.ops.sub_cell else None,
+            cavity=cavity, cavitation_pressure=self.prob.cavitation_pressure)
+
 
 def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,
                     tolerance: float = 0.01, transit_length: float | None = None,
@@ -82,62 +210,15 @@ def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,
     reading took for a balance. ``start``: a solution (on any
     grid) whose oil fractions replace the initial puddle. ``courant``: the step over a cell's
     transit at u. ``progress`` is called with each transit's record."""
-    grid = Grid.build(prob)
-    d, u = grid.cell, prob.speed
-    h = np.nan_to_num(grid.h)
-    ops = Operators(prob, grid)
-    if start is None:
-        X, Y = np.meshgrid(grid.x, grid.y)
-        c = np.where((np.hypot(X, Y) < prob.initial_radius) & ~grid.island, h, 0.0)
-    else:
-        c = oil_fraction_on(start, grid) * h              # a full cell may hold more: it returns it
-    dt = courant * d / u
-    transit = (transit_length or (prob.x_range[1] - prob.x_range[0])) / u
-    steps_per_transit = max(1, int(round(transit / dt)))
-    q_in = float(ops.q_supply.sum())
-    oil_start = float(c.sum()) * d * d
-    oil_in = oil_out = out_this_transit = 0.0
-    dry_this_transit = 0
-    history: list[dict] = []
+    m = Marcher(prob, start=start, courant=courant, transit_length=transit_length)
     steady = False
-    step = 0
-    flooded = (c >= h * (1.0 - 1e-9)) & ~grid.island
-    p = np.full(c.shape, np.nan)
-    while step < transits_max * steps_per_transit:
-        p, dc, q_out, opened = ops.step(flooded, c, dt)
-        c = c + dc
-        flooded = (c >= h * (1.0 - 1e-9)) & ~opened & ~grid.island
-        step += 1
-        oil_in += q_in * dt
-        oil_out += q_out * dt
-        out_this_transit += q_out * dt
-        dry_this_transit += int(opened.sum())
-        if step % steps_per_transit:
+    while m.steps < transits_max * m.steps_per_transit:
+        m.step()
+        if m.steps % m.steps_per_transit:
             continue
-        region = connected_region(flooded, grid.island)
-        rows = np.nonzero(region.any(axis=1))[0]
-        rec = {"time_s": step * dt, "oil_m3": float(np.sum(np.where(region, h, 0.0))) * d * d,
-               "flooded_cells": int(region.sum()),
-               "outflow_over_supply": out_this_transit / (q_in * steps_per_transit * dt)
-               if q_in > 0 else 0.0,
-               "width_m": float(2 * (grid.y[rows[-1]] + d / 2)) if rows.size else 0.0,
-               "cells_opened_dry": dry_this_transit}
-        history.append(rec)
-        out_this_transit, dry_this_transit = 0.0, 0
         if progress:
-            progress(rec)
-        if tolerance > 0 and len(history) > window:
-            change = abs(rec["oil_m3"] - history[-1 - window]["oil_m3"])
-            out = np.mean([r["outflow_over_supply"] for r in history[-window:]])
-            if change <= tolerance * rec["oil_m3"] and abs(out - 1.0) <= tolerance:
-                steady = True
-                break
-    oil_end = float(c.sum()) * d * d
-    return ThinFilmSolution(
-        grid=grid, p=np.where(flooded, p, np.nan), content=c, flooded=flooded,
-        time=step * dt, steps=step, flux_in=q_in,
-        flux_out=history[-1]["outflow_over_supply"] * q_in if history else 0.0,
-        steady=steady, island_radius=prob.island_radius, history=history,
-        mass_balance_error=abs(oil_end - oil_start - oil_in + oil_out) / oil_in
-        if oil_in > 0 else 0.0,
-        fill=np.where(flooded, 0.0, ops.fill(c)) if ops.sub_cell else None)
+            progress(m.history[-1])
+        if m.balanced(tolerance, window):
+            steady = True
+            break
+    return m.solution(steady)

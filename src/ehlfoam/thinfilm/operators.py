@@ -1,6 +1,7 @@
 """The discrete thin-film model on one grid: the faces' conductances and Couette fluxes, the
 menisci's positions and pressures, the pressure solve on the flooded cells and the oil each
-step moves (:class:`Operators`; the model: :mod:`ehlfoam.thinfilm.march`)."""
+step moves (:class:`Operators`; the model: :mod:`ehlfoam.thinfilm.march`; its outlet, the
+cavities at the cavitation pressure: :mod:`ehlfoam.thinfilm.cavity`)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.linalg import spsolve
 
+from ehlfoam.thinfilm.cavity import cavities
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
@@ -47,6 +49,8 @@ class Operators:
         self.theta_a = None if prob.advancing_angle is None else np.radians(prob.advancing_angle)
         self.dry = 1.0 - on_track[:, None]             # walls coming in dry: off the track
         self.sub_cell = prob.meniscus_position == "sub-cell"
+        self.p_cav = prob.cavitation_pressure          # gauge [Pa] or None
+        self.closed_side = prob.closed_side
         # the oil an open cell holds as the walls' layers, not as meniscus: the supply's
         # layers ahead of the contact, the films elsewhere [m]
         ahead = (grid.x < 0)[None, :] & np.ones_like(self.island)
@@ -75,21 +79,38 @@ class Operators:
             factor = factor + self.dry * (np.cos(theta) / np.cos(self.theta_s) - 1.0)
         return factor
 
-    def fill(self, c: np.ndarray) -> np.ndarray:
+    def fill(self, c: np.ndarray, cavity: np.ndarray | None = None) -> np.ndarray:
         """How far into each cell a meniscus beside it reaches: the cell's bulk oil (beyond
-        the walls' layers) over its room for it, 0-1."""
+        the walls' layers) over its room for it, 0-1; in a cavity, its film content over
+        its gap (the oil the walls carry through it: Elrod-Adams's fraction)."""
         room = self.h - self.layers
-        return np.clip((c - self.layers) / np.where(room > 0, room, 1.0), 0.0, 1.0)
+        out = np.clip((c - self.layers) / np.where(room > 0, room, 1.0), 0.0, 1.0)
+        if cavity is None or not cavity.any():
+            return out
+        full = np.clip(c / np.where(self.h > 0, self.h, 1.0), 0.0, 1.0)
+        return np.where(cavity, full, out)
 
-    def menisci(self, flooded: np.ndarray, c: np.ndarray) -> "_Faces":
+    def cavities(self, flooded: np.ndarray) -> np.ndarray:
+        """The open cells whose gas the flooded region encloses, at the cavitation pressure
+        (:func:`ehlfoam.thinfilm.cavity.cavities`); none without one."""
+        if self.p_cav is None:
+            return np.zeros_like(flooded)
+        return cavities(flooded, self.island, self.closed_side)
+
+    def menisci(self, flooded: np.ndarray, c: np.ndarray,
+                cavity: np.ndarray | None = None) -> "_Faces":
         """Each face between a flooded cell and an open one: the flooded cell's conductance
         to the meniscus and the meniscus's pressure, for x faces and y faces. The meniscus
         sits theta cells from the flooded cell's centre, at the gap there (linear between
         the two centres), conductance g / theta: sub-cell, theta = 1/2 + the open cell's
         fill; cell, theta = 1 (the open cell's centre). Its pressure: Young-Laplace's,
-        times the dynamic menisci's factor (``pull_factor``)."""
+        times the dynamic menisci's factor (``pull_factor``), but no lower than the
+        cavitation pressure; a cavity's boundary (``cavity``: the open cells the region
+        encloses) is at the cavitation pressure."""
+        if cavity is None:
+            cavity = np.zeros_like(flooded)
         factor = np.broadcast_to(self.pull_factor(flooded), flooded.shape)
-        theta = 0.5 + self.fill(c) if self.sub_cell else np.ones_like(c)
+        theta = 0.5 + self.fill(c, cavity) if self.sub_cell else np.ones_like(c)
         per_axis = {}
         for axis, g in ((1, self.gx), (0, self.gy)):
             lo = [slice(None), slice(None)]
@@ -103,7 +124,11 @@ class Operators:
             h_m = h_f + th * (h_o - h_f)
             safe = np.where(h_m > 0, h_m, 1.0)          # faces on the island carry nothing
             suction = np.where(hi_open, factor[hi], factor[lo]) * self.young_laplace / safe
-            per_axis[axis] = (g / th, np.where(h_m > 0, -suction, 0.0), h_m)
+            p_m = np.where(h_m > 0, -suction, 0.0)
+            if self.p_cav is not None:
+                p_m = np.where(np.where(hi_open, cavity[hi], cavity[lo]), self.p_cav,
+                               np.maximum(p_m, self.p_cav))
+            per_axis[axis] = (g / th, p_m, h_m)
         (gx, px, hx), (gy, py, _) = per_axis[1], per_axis[0]
         return _Faces(gx=gx, gy=gy, px=px, py=py, hx=hx)
 
@@ -153,36 +178,51 @@ class Operators:
         p[flooded] = spsolve(A, rhs, permc_spec="MMD_AT_PLUS_A")
         return p
 
-    def step(self, flooded: np.ndarray, c: np.ndarray, dt: float):
-        """One step: (p, change of the oil [m], flux leaving the domain [m3/s], the flooded
-        cells opened). An open cell gives no more than it holds: the flooded cells drawing
-        on it get less and run short of a full gap (air comes in: they open next step). A
-        flooded cell that would run dry within the step opens now, and p is solved again."""
+    def step(self, flooded: np.ndarray, c: np.ndarray, dt: float) -> "Step":
+        """One step (:class:`Step`). An open cell gives no more than it holds: the flooded
+        cells drawing on it get less and run short of a full gap (air comes in: they open
+        next step). A flooded cell that would run dry within the step opens now, and one
+        whose pressure falls below the cavitation pressure opens to gas now (its oil stays:
+        Elrod-Adams's complementarity, :mod:`ehlfoam.thinfilm.cavity`); p is solved again
+        until neither happens."""
         opened = np.zeros_like(flooded)
+        cavitated = np.zeros_like(flooded)
         for _ in range(1000):
-            faces = self.menisci(flooded, c)
+            cavity = self.cavities(flooded)
+            faces = self.menisci(flooded, c, cavity)
             p = self.pressure(flooded, c, dt, faces)
-            dc, q_out = self.move(flooded, p, c, dt, faces)
+            if self.p_cav is not None:
+                low = flooded & (p < self.p_cav - 1e-9 * abs(self.p_cav))
+                if low.any():
+                    cavitated |= low
+                    flooded = flooded & ~low
+                    continue
+            dc, q_outlet, q_side = self.move(flooded, p, c, dt, faces, cavity)
             dry = flooded & (c + dc < 0.0)
             if not dry.any():
-                return p, dc, q_out, opened
+                return Step(p, dc, q_outlet, q_side, opened, cavitated, cavity)
             opened |= dry
             flooded = flooded & ~dry
         raise RuntimeError("the flooded set did not settle within a step")
 
     def move(self, flooded: np.ndarray, p: np.ndarray, c: np.ndarray, dt: float,
-             faces: "_Faces"):
-        """The change of the oil in every cell over dt [m] and the flux leaving the domain
-        [m3/s], the menisci at ``faces``. An open cell gives no more than it holds: what
-        the flooded region draws from it is cut back first (the flooded cell runs short of a
-        full gap), the films and layers it passes on only when that is not enough."""
+             faces: "_Faces", cavity: np.ndarray | None = None):
+        """The change of the oil in every cell over dt [m] and the fluxes leaving the
+        domain through the outlet and the side [m3/s], the menisci at ``faces``. An open
+        cell gives no more than it holds: what the flooded region draws from it is cut back
+        first (the flooded cell runs short of a full gap), the films and layers it passes on
+        only when that is not enough. A cavity's cells (``cavity``) pass on all the oil they
+        hold, as no air meniscus holds it back."""
         u, d = self.u, self.d
+        if cavity is None:
+            cavity = np.zeros_like(flooded)
         fl, fr = flooded[:, :-1], flooded[:, 1:]
-        touch = touches(flooded) & ~self.island
+        touch = touches(flooded) & ~self.island & ~cavity
         # x faces lo -> hi: Poiseuille where a side is flooded, plus what the walls carry:
         # a full gap out of a flooded cell, the films a receding meniscus lays out of the
-        # cell behind one, at most those films out of a cell beside one, else the layers
-        lays = fl[:, :-1] & ~flooded[:, 1:-1] & ~flooded[:, 2:]
+        # cell behind one, at most those films out of a cell beside one, else the layers;
+        # all of a cavity's oil
+        lays = fl[:, :-1] & ~flooded[:, 1:-1] & ~flooded[:, 2:] & ~cavity[:, 1:-1]
         carry = np.where(touch[:, :-1] & ~fr, np.minimum(c[:, :-1], self.cap[:, :-1]),
                          c[:, :-1])
         carry[:, 1:] = np.where(lays, self.film * faces.hx[:, :-1], carry[:, 1:])
@@ -228,7 +268,23 @@ class Operators:
                     q_last = q_last * scale[:, -1]
                     q_side = q_side * scale[-1]
         net = _net(qx, qy, q_last, q_side, self.q_supply)
-        return net * dt / (d * d), float(q_last.sum() + q_side.sum())
+        return net * dt / (d * d), float(q_last.sum()), float(q_side.sum())
+
+
+class Step(NamedTuple):
+    """What one step did: p [Pa, gauge] on the flooded cells (NaN elsewhere), the change of
+    every cell's oil [m], the fluxes leaving through the outlet and the side [m3/s], the
+    flooded cells it opened as they ran dry, those it opened to gas (below the cavitation
+    pressure), and the cavities' cells (the open cells the region enclosed, at the
+    cavitation pressure)."""
+
+    p: np.ndarray
+    dc: np.ndarray
+    q_outlet: float
+    q_side: float
+    opened: np.ndarray
+    cavitated: np.ndarray
+    cavity: np.ndarray
 
 
 class _Faces(NamedTuple):

@@ -69,6 +69,11 @@ class ThinFilmProblem:
             it move smoothly as the cell fills; "cell", at the cell's centre, so that they
             jump a cell at a time as cells flood and open (the first version: its balance
             moved by 6-16 % at each halving of the step).
+        cavitation_pressure: the gauge pressure [Pa, < 0] below which the oil gives up gas
+            (the gas-release pressure less the ambient one); None: the oil holds any
+            tension (no outlet model). With it, a flooded cell whose pressure would fall
+            below it opens to gas, the gas the flooded region encloses is at it, and a
+            meniscus's pressure never falls below it (:mod:`ehlfoam.thinfilm.cavity`).
     """
 
     gap: Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -89,6 +94,7 @@ class ThinFilmProblem:
     normal_length: float | None = None
     advancing_angle: float | None = None
     meniscus_position: Literal["sub-cell", "cell"] = "sub-cell"
+    cavitation_pressure: float | None = None
 
     def __post_init__(self) -> None:
         span = min(self.y_max / 2, (self.x_range[1] - self.x_range[0]) / 8)
@@ -121,6 +127,10 @@ class ThinFilmProblem:
                               or 0.5 * self.cell <= self.normal_length <= span,
                               f"None or in [{0.5 * self.cell:.3g}, {span:.3g}] m: half a "
                               "cell to the span of the cell's check"),
+            "cavitation_pressure": (self.cavitation_pressure, self.cavitation_pressure is None
+                                    or (np.isfinite(self.cavitation_pressure)
+                                        and self.cavitation_pressure < 0),
+                                    "None or a finite gauge pressure < 0 Pa (below ambient)"),
         }
         for name, (value, ok, valid) in checks.items():
             if not ok:

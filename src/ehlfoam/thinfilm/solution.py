@@ -21,7 +21,9 @@ class ThinFilmSolution:
     hundreds mean the step or the pull's normal drives the menisci unstably)
     and the oil mass balance error over the march (the oil gained less what came in and
     went out, over what came in); with sub-cell menisci, ``fill``: how far into each open
-    cell its meniscus reaches (0-1)."""
+    cell its meniscus reaches (0-1; in a cavity its film content over its gap); with the
+    outlet model, ``cavity``: the open cells whose gas the region encloses, at the gauge
+    ``cavitation_pressure`` [Pa] (:mod:`ehlfoam.thinfilm.cavity`)."""
 
     grid: Grid
     p: np.ndarray
@@ -36,6 +38,8 @@ class ThinFilmSolution:
     history: list[dict] = field(default_factory=list)
     mass_balance_error: float = 0.0
     fill: np.ndarray | None = None
+    cavity: np.ndarray | None = None
+    cavitation_pressure: float | None = None
 
     def region(self) -> np.ndarray:
         """The flooded cells connected to the island: the flooded region, bool (ny, nx)."""
@@ -58,6 +62,28 @@ class ThinFilmSolution:
         off = ((x < self.grid.x[0] - d / 2) | (x > self.grid.x[-1] + d / 2)
                | (y > self.grid.y[-1] + d / 2))
         return np.where(off, np.nan, _nearest_cell(self.grid, frac, x, y))
+
+    def mid_gap_alpha(self) -> np.ndarray:
+        """What a 3D case's mid-gap oil fraction would read in each cell (ny, nx; NaN in the
+        island), for the flow-pattern metrics of the 3D cases (:mod:`ehlfoam.metrics.pattern`,
+        which read the alpha = 0.5 crossing between cell centres linearly): 1 in the flooded
+        cells; in an open cell beside them, f / (1/2 + f) for the meniscus's fill f (0-1), so
+        that the crossing falls where the model puts the meniscus, 1/2 + f cells from the
+        flooded cell's centre; 0 where the walls carry only films or layers (gas at
+        mid-gap). In a cavity f is the film content over the gap."""
+        f = np.zeros(self.flooded.shape) if self.fill is None else np.clip(self.fill, 0, 1)
+        alpha = np.where(self.flooded, 1.0, f / (0.5 + f))
+        return np.where(self.grid.island, np.nan, alpha)
+
+    def gauge_pressure(self) -> np.ndarray:
+        """The pressure of every cell [Pa, gauge; NaN in the island]: the solved one in the
+        flooded cells, the cavitation pressure in the cavities, 0 (ambient) in the outer
+        air."""
+        gas = np.zeros(self.flooded.shape)
+        if self.cavity is not None and self.cavitation_pressure is not None:
+            gas = np.where(self.cavity, self.cavitation_pressure, 0.0)
+        p = np.where(self.flooded, np.nan_to_num(self.p), gas)
+        return np.where(self.grid.island, np.nan, p)
 
     def metrics(self, a: float) -> dict:
         """The flow-pattern metrics of the CFD cases (ehlfoam.metrics.pattern), in units of a."""
