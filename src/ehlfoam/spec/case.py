@@ -37,10 +37,13 @@ from ehlfoam.errors import SpecError, format_validation_error
 from ehlfoam.spec.levels import FOLLOW_POLAR_RADIUS, POLAR_RING_SHARE
 from ehlfoam.spec.mesh import Mesh
 from ehlfoam.spec.sections import STRICT, Domain, Physics, Run, Supply
+from ehlfoam.spec.thin_film import ThinFilm, check_thin_film
 
-#: The OpenFOAM application of each scene.
+#: The OpenFOAM application of each scene ("thin-film": none, the gap-averaged model of
+#: ehlfoam.thinfilm).
 SOLVERS = {"interface": "interFoam", "single-phase": "interFoam",
-           "cavitating": "compressibleInterFoam", "gas-release": "interPhaseChangeFoam"}
+           "cavitating": "compressibleInterFoam", "gas-release": "interPhaseChangeFoam",
+           "thin-film": "thin-film"}
 
 
 class CaseSpec(BaseModel):
@@ -49,7 +52,8 @@ class CaseSpec(BaseModel):
 
     model_config = STRICT
     name: str = Field("case", description="Label of the case in reports.")
-    scene: Literal["interface", "single-phase", "cavitating", "gas-release"] = Field(
+    scene: Literal["interface", "single-phase", "cavitating", "gas-release",
+                   "thin-film"] = Field(
         "interface",
         description='The flow modelled. "interface": two-phase oil and air with surface '
                     'tension, no cavitation (interFoam); "single-phase": oil everywhere (the '
@@ -57,7 +61,11 @@ class CaseSpec(BaseModel):
                     'that expands below ambient pressure, down to the cavitation pressure '
                     '(compressibleInterFoam); "gas-release": oil below the cavitation pressure '
                     'turns into gas at physics.gas_release_rate, and the air has the oil\'s '
-                    'kinematic viscosity (interPhaseChangeFoam).')
+                    'kinematic viscosity (interPhaseChangeFoam); "thin-film": the gap-averaged '
+                    'model, no OpenFOAM: Reynolds flow inside Young-Laplace menisci, '
+                    'Landau-Levich films, and gas at physics.cavitation_pressure where the oil '
+                    'would fall below it (the [thin_film] table; seconds to minutes a case; '
+                    'keys only the 3D scenes read are refused).')
     contact: PrecalcSpec = Field(
         PrecalcSpec(speed=0.008),
         description="The EHL conditions (load, speed, oil, ball): the precalc's spec.")
@@ -69,6 +77,9 @@ class CaseSpec(BaseModel):
     run: Run = Field(Run(), description="Time stepping, steady-state detection and limits.")
     walls_moving: bool = Field(True, description="False holds both walls still (the "
                                                  "static-meniscus test).")
+    thin_film: ThinFilm = Field(ThinFilm(), description='The gap-averaged model of scene = '
+                                                        '"thin-film": its grid and closures '
+                                                        '(the 3D scenes ignore it).')
 
     @model_validator(mode="after")
     def _polar_ring_inside(self) -> "CaseSpec":
@@ -190,6 +201,7 @@ def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> Case
     except SpecError as err:  # raised by PrecalcSpec's own validators
         raise SpecError(f"invalid case spec: contact: {err}") from None
     _check_supply_fits(spec)
+    check_thin_film(spec)
     _check_scene_options(spec)
     return spec
 
