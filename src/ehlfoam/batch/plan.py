@@ -19,6 +19,7 @@ from typing import Any
 from ehlfoam.batch.spec import BatchSpec, load_batch_spec, overrides, rounded
 from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import CaseSpec, make_case_spec
+from ehlfoam.spec.thin_film import thin_film_cpu_s
 
 __all__ = ["PARAM_KEYS", "PlannedCase", "case_id", "est_cpu_s", "expand", "load_plan"]
 
@@ -233,6 +234,9 @@ def load_plan(path: str | Path) -> tuple[BatchSpec, list[PlannedCase]]:
 
 def est_cpu_s(spec: CaseSpec) -> float:
     """A rough CPU cost [s] of building and running a case (for ordering and the first ETA):
-    the level's CPU per simulated ms times the simulated time, plus the build."""
+    the level's CPU per simulated ms times the simulated time, plus the build; a thin-film
+    case's from its cells and steps (:func:`ehlfoam.spec.thin_film.thin_film_cpu_s`)."""
+    if spec.scene == "thin-film":
+        return thin_film_cpu_s(spec)
     per_ms = CPU_PER_SIMULATED_MS.get(spec.mesh.resolution, 1.0)
     return BUILD_CPU_S + per_ms * spec.end_time * 1e3

@@ -25,6 +25,7 @@ from ehlfoam._io import atomic_write_json, atomic_write_text
 from ehlfoam.case.dictionaries import edit_physics_dicts, edit_run_control, release_geometry
 from ehlfoam.case.fields import edit_fields, with_supply_patch
 from ehlfoam.case.geometry import META, CaseGeometry
+from ehlfoam.case.thin_film import write_thin_film_case
 from ehlfoam.case.timestep import capillary_time_step, write_interval
 from ehlfoam.foam.runtime import FoamRuntime
 from ehlfoam.gap.source import load_gap
@@ -94,6 +95,8 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
     if out.exists() and any(out.iterdir()):
         if not overwrite:
             raise CaseExists(f"output folder {out} exists and is not empty (use --overwrite)")
+    if spec.scene == "thin-film":   # the gap-averaged model's case: no OpenFOAM (issue 74)
+        return write_thin_film_case(spec, out)
     runtime = runtime or FoamRuntime.from_environment()
     gap, precalc = load_gap(spec.contact)
     a = spec.a

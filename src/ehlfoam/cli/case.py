@@ -87,7 +87,7 @@ def cmd_case(args: argparse.Namespace) -> int:
         from ehlfoam.seed.start import RampError, check_start
 
         try:   # before anything is written
-            check_start(args.start_from)
+            check_start(args.start_from, spec.scene)
         except (RampError, OSError) as err:   # missing, or not a folder
             return _bad(f"--start-from {args.start_from}: {err}")
     return _write(spec, args)
@@ -120,6 +120,13 @@ def _write(spec, args: argparse.Namespace) -> int:
               f"{', '.join(seed['fields'])})")
         if seed.get("oil"):
             print(oil_carried(seed["oil"]))
+    if spec.scene == "thin-film":   # no OpenFOAM: the model's grid (issue 74)
+        print(f"case {args.out}: thin-film model, {geom.cells} cells of "
+              f"{geom.min_cell_size / geom.a:g} a, a = {geom.a * 1e3:.4f} mm, transit "
+              f"{geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, step "
+              f"{geom.max_delta_t:.3g} s, cavitation pressure "
+              f"{spec.physics.cavitation_pressure:g} Pa")
+        return EXIT_OK
     print(f"case {args.out}: {geom.solver}, {geom.cells} cells, a = {geom.a * 1e3:.4f} mm, "
           f"transit {geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, "
           f"maxDeltaT {geom.max_delta_t:.3g} s ({geom.capillary_limit}), "

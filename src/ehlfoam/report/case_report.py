@@ -185,7 +185,15 @@ def _report_case(case_dir: str | os.PathLike, animate: bool, gif_frames: int) ->
         page.log_href = _rel(info.log_path, out)
 
     fields = None
-    if info.geom is not None:
+    thin = info.scene == "thin-film"   # the gap-averaged model's state, no OpenFOAM fields
+    if info.geom is not None and thin:
+        from ehlfoam.report.thin_film import load_thin_film_fields
+
+        fields = steps.run("read state", load_thin_film_fields, case, info.geom)
+        if fields is None and "read state" not in " ".join(problems):
+            page.summary.append("No state.npz yet (the thin-film case has not run): nothing "
+                                "to picture.")
+    elif info.geom is not None:
         from ehlfoam.report.fields import load_fields
 
         amb = getattr(info.geom, "ambient_pressure", 1.013e5)
@@ -196,11 +204,12 @@ def _report_case(case_dir: str | os.PathLike, animate: bool, gif_frames: int) ->
     summary_top = None
     if fields is not None:
         summary_top = steps.run("top view", _top_view, info, fields, out, page)
-        steps.run("side view", _side_view, info, fields, out, page)
+        if not thin:
+            steps.run("side view", _side_view, info, fields, out, page)
         steps.run("pressure map", _pressure, info, fields, out, page)
     steps.run("precalc picture", _precalc, info, out, page)
     settle = steps.run("history chart", _history, info, out, page)
-    if animate and fields is not None:
+    if animate and fields is not None and not thin:
         steps.run("transient GIF", _gif, info, fields, out, page, gif_frames)
     if summary_top:
         page.summary.extend(summary_top)
@@ -261,9 +270,13 @@ def _top_view(info: CaseInfo, fields, out: Path, page: Page) -> list[str]:
                        oil_volume=oil)
     stamp = None if info.status == "finished" else info.status.upper()
     thumbnail(tv.path, out / "thumb.png", box=axes_box(tv), stamp=stamp)
+    what = ("Oil fraction at mid-gap (amber: oil, pale: air)" if info.scene != "thin-film"
+            else "The thin-film model's oil as a mid-gap oil fraction (amber: the flooded "
+                 "region, its menisci where the model puts them within their cells; pale: "
+                 "air or gas, with films or layers on the walls)")
     page.figures.append(Figure(
         "top_view.png", "Top view (as through the glass disc)",
-        "Oil fraction at mid-gap (amber: oil, pale: air), the metrics' own raster (a/20) and "
+        f"{what}, the metrics' own raster (a/20) and "
         "alpha = 0.5 meniscus line (black); grey disc: the island wall around the unmeshed "
         "contact, dashed: the Hertzian circle; red: the bubble (gas enclosed at the contact "
         "exit) and its length l from x = a along y = 0."))
@@ -296,7 +309,9 @@ def _pressure(info: CaseInfo, fields, out: Path, page: Page) -> None:
         page.problems.append("pressure map: no p or p_rgh written")
         return
     page.figures.append(Figure(
-        "pressure.png", "Pressure around the contact (CFD)",
+        "pressure.png", "Pressure around the contact ("
+        + ("thin-film model: the gas in a cavity at the cavitation pressure, the outer air at "
+           "ambient)" if info.scene == "thin-film" else "CFD)"),
         f"Mid-gap gauge pressure; hatched: sub-ambient (p < -{pv.threshold / 1e3:.2g} kPa, "
         f"1 % of the largest |p|). Lowest {pv.p_min / 1e3:.3g} kPa, highest "
         f"{pv.p_max / 1e3:.3g} kPa. Below: along y = 0."))

@@ -34,6 +34,7 @@ from pathlib import Path
 from foamlib import FoamFile
 
 from ehlfoam.case.geometry import META, CaseGeometry, load_geometry, load_spec_of
+from ehlfoam.case.thin_film import is_thin_film_case
 from ehlfoam.foam.runtime import FoamRuntime
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run import fields as case_fields
@@ -42,6 +43,7 @@ from ehlfoam.run.balance import (OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, dissolved
 from ehlfoam.run.final import RunEnd, final_record
 from ehlfoam.run.history import write_history
 from ehlfoam.run.steady import steady_test
+from ehlfoam.run.thin_film import run_thin_film_case
 from ehlfoam.run.warnings import (CLEARANCE_WARNING, FRONT_CELL_WARNING, OFF_OUTLET_WARNING,
                                   REAR_CELL_WARNING, boundary_warnings, front_cell_warnings,
                                   rear_cell_warnings, rear_meniscus_cell)
@@ -124,6 +126,9 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
     if extend_transits is not None and not extend_transits > 0:
         raise ValueError(f"extend_transits = {extend_transits!r} transits: it must be > 0")
     path = Path(case).absolute()
+    if is_thin_film_case(path):   # the gap-averaged model, no solver (issue 74)
+        return run_thin_film_case(path, wall_limit=wall_limit, on_sample=on_sample,
+                                  extend_transits=extend_transits, busy=CaseBusy)
     run = _Case(path, load_spec_of(path), load_geometry(path),
                 case_fields.Structure.load(path))
     lock = open(path / META / "run.lock", "w")

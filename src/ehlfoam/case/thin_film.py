@@ -1,0 +1,97 @@
+"""A thin-film case (``scene = "thin-film"``): a case folder that the gap-averaged model runs,
+without OpenFOAM.
+
+    spec -> gap (ehlfoam.gap, cached) -> the model's grid (ehlfoam.thinfilm) -> case folder
+
+The folder holds what a 3D case's holds for the run, the metrics and the reports, and no
+OpenFOAM files: ``ehlfoam/spec.json``, ``ehlfoam/geometry.json`` (a :class:`CaseGeometry`
+whose solver is "thin-film", its cells the grid's), ``ehlfoam/thin_film.json`` (the grid and
+the model's options: the marker of a thin-film case), ``precalc/`` (the EHL precalc the gap
+comes from) and, when it starts from a state, ``ehlfoam/start.npz``. ``ehlfoam run DIR``
+marches it (:mod:`ehlfoam.run.thin_film`) and writes ``metrics.json``, ``history.csv``,
+``state.npz`` and ``log.thin-film``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ehlfoam._io import atomic_write_json, atomic_write_text
+from ehlfoam.case.geometry import META, CaseGeometry
+from ehlfoam.gap.source import load_gap
+from ehlfoam.spec.case import CaseSpec
+from ehlfoam.spec.thin_film import thin_film_cells
+from ehlfoam.thinfilm.from_spec import problem_from_spec, scene_options
+from ehlfoam.thinfilm.problem import Grid
+
+__all__ = ["MARKER", "START", "is_thin_film_case", "read_marker", "write_thin_film_case"]
+
+#: in ``ehlfoam/``: the grid and the options of a thin-film case (its marker), and the state
+#: it starts from
+MARKER, START = "thin_film.json", "start.npz"
+
+
+def is_thin_film_case(case: str | os.PathLike) -> bool:
+    """True for a case folder written for ``scene = "thin-film"``."""
+    return (Path(case) / META / MARKER).is_file()
+
+
+def read_marker(case: str | os.PathLike) -> dict[str, Any]:
+    """The ``ehlfoam/thin_film.json`` of a thin-film case: its grid (cell [a] and [m], nx,
+    ny, the cells outside the island), domain [a], options and step [s]."""
+    return json.loads((Path(case) / META / MARKER).read_text())
+
+
+def write_thin_film_case(spec: CaseSpec, out: str | os.PathLike) -> CaseGeometry:
+    """Write the thin-film case of ``spec`` in ``out`` (built in a temporary sibling folder
+    and renamed into place, replacing what is there: the caller has checked that it may).
+    Returns its :class:`CaseGeometry`."""
+    out = Path(out)
+    gap, precalc = load_gap(spec.contact)
+    options = scene_options(spec)
+    prob = problem_from_spec(spec, gap, options)
+    grid = Grid.build(prob)
+    cells = int((~grid.island).sum())
+    a, d = spec.a, grid.cell
+    dt = spec.thin_film.courant * d / spec.speed
+    summary = json.loads((precalc / "summary.json").read_text())
+    hc = float(summary["hc_m"])
+    box = spec.domain.box(a)
+    geom = CaseGeometry(
+        a=a, radius=spec.contact.radius, speed=spec.speed, x_min=box.x_min, x_max=box.x_max,
+        y_max=box.y_max, island_radius=box.island_radius, symmetric=True, n_layers=1,
+        cells=cells, transit_time=spec.transit_time, end_time=spec.end_time,
+        write_interval=spec.transit_time / spec.run.writes_per_transit, max_delta_t=dt,
+        capillary_limit="none", min_cell_size=d,
+        island_gap=float(gap(np.array([box.island_radius]), np.array([0.0]))[0]),
+        hc=hc, contact_flow=spec.speed * hc * 2.0 * a, gap_mismatch=0.0,
+        oil_viscosity=spec.oil_viscosity, oil_density=spec.oil_density, solver=spec.solver,
+        ambient_pressure=spec.physics.ambient_pressure)
+    marker = {"cell_over_a": options.cell, "cell_m": d, "nx": len(grid.x), "ny": len(grid.y),
+              "grid_cells": thin_film_cells(spec), "cells": cells,
+              "domain_over_a": list(options.domain), "options": asdict(options),
+              "cavitation_pressure_gauge_Pa": prob.cavitation_pressure, "time_step_s": dt}
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))
+    try:
+        meta = tmp / META
+        meta.mkdir()
+        atomic_write_text(meta / "spec.json", spec.model_dump_json(indent=2) + "\n")
+        atomic_write_json(meta / "geometry.json", asdict(geom))
+        atomic_write_json(meta / MARKER, marker)
+        shutil.copytree(precalc, tmp / "precalc")
+        if out.exists():
+            shutil.rmtree(out)
+        os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return geom

@@ -1,0 +1,76 @@
+"""The flow-pattern metrics of a thin-film state (:mod:`ehlfoam.thinfilm`), read by the same
+topology code as the 3D cases' (:func:`ehlfoam.metrics.pattern.flow_pattern_from_raster`).
+
+The model's cells are a regular grid over the half domain; what a 3D case's mid-gap oil
+fraction would read in each of them (:meth:`ThinFilmSolution.mid_gap_alpha`: 1 in the
+flooded region, the menisci where the model puts them within their cells, 0 where the walls
+carry only films or layers) is resampled onto the metrics' raster (a/20 pixels, the half
+domain mirrored) linearly between the cell centres, as the 3D cases' cell centres are
+(bilinear here, on the Delaunay triangles there; the edge cells' values beyond the outer
+centres), and the pattern is read off that raster. SI inside; lengths out as ratios to a.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+from scipy.interpolate import RegularGridInterpolator
+
+from ehlfoam.metrics.pattern import bubble_mask, flow_pattern_from_raster
+from ehlfoam.metrics.raster import DEFAULT_CELL_OVER_A, Geometry, Raster, _grid
+from ehlfoam.thinfilm.solution import ThinFilmSolution
+
+__all__ = ["thin_film_pattern", "thin_film_raster"]
+
+
+def _outside_island(values: np.ndarray, island: np.ndarray) -> np.ndarray:
+    """``values`` with each island cell given its nearest outside cell's value (so that the
+    interpolation next to the rim reads the cells there, not across the island)."""
+    if not island.any() or island.all():
+        return values
+    nearest = ndimage.distance_transform_edt(island, return_distances=False,
+                                             return_indices=True)
+    return values[tuple(nearest)]
+
+
+def thin_film_raster(sol: ThinFilmSolution, geom: Geometry,
+                     cell: float | None = None) -> Raster:
+    """The state's mid-gap oil fraction on the metrics' raster of ``geom`` (a half domain,
+    mirrored; pixels of ``cell`` [m], by default a/20): linear between the model's cell
+    centres, the outer cells' values beyond them, NaN on the island."""
+    grid = sol.grid
+    alpha = _outside_island(np.nan_to_num(sol.mid_gap_alpha()), grid.island)
+    y = np.concatenate([-grid.y[::-1], grid.y])
+    f = RegularGridInterpolator((y, grid.x), np.vstack([alpha[::-1], alpha]),
+                                method="linear")
+    xs, ys = _grid(geom, float(cell if cell is not None else DEFAULT_CELL_OVER_A * geom.a))
+    gx, gy = np.meshgrid(np.clip(xs, grid.x[0], grid.x[-1]), np.clip(ys, y[0], y[-1]))
+    values = np.clip(f(np.column_stack([gy.ravel(), gx.ravel()])).reshape(gx.shape), 0, 1)
+    X, Y = np.meshgrid(xs, ys)
+    island = X**2 + Y**2 <= geom.island_radius**2
+    values[island] = np.nan
+    return Raster(x=xs, y=ys, alpha=values, island=island, geom=geom)
+
+
+def _bubble_volume(r: Raster, sol: ThinFilmSolution) -> float:
+    """Gas [m3, whole contact] in the model's cells under the bubble's footprint (the
+    :func:`bubble_mask` pixels at their centres): their gap less their oil."""
+    mask = bubble_mask(r)
+    if not mask.any():
+        return 0.0
+    grid = sol.grid
+    ix = np.clip(np.rint((grid.x - r.x[0]) / r.dx).astype(int), 0, len(r.x) - 1)
+    iy = np.clip(np.rint((grid.y - r.y[0]) / r.dy).astype(int), 0, len(r.y) - 1)
+    under = mask[np.ix_(iy, ix)] & ~grid.island
+    gas = np.where(under, np.nan_to_num(grid.h) - sol.content, 0.0)
+    return 2.0 * float(np.clip(gas, 0.0, None).sum()) * grid.cell ** 2
+
+
+def thin_film_pattern(sol: ThinFilmSolution, geom: Geometry) -> tuple[dict, Raster]:
+    """The flow-pattern metrics of the state (:func:`flow_pattern_from_raster`'s keys, and
+    ``bubble_volume_m3``: the gas under the bubble, whole contact) and the raster they were
+    read from."""
+    r = thin_film_raster(sol, geom)
+    pattern = flow_pattern_from_raster(r)
+    pattern["bubble_volume_m3"] = _bubble_volume(r, sol)
+    return pattern, r

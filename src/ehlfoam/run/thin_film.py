@@ -1,0 +1,224 @@
+"""Run a thin-film case (``scene = "thin-film"``, :mod:`ehlfoam.case.thin_film`) to its
+balance and write ``DIR/metrics.json``: the gap-averaged model (:mod:`ehlfoam.thinfilm`)
+marched in this process, no OpenFOAM.
+
+The run is watched as the 3D runs are (:mod:`ehlfoam.run.monitor`): at each write
+(``run.writes_per_transit`` a transit) it samples the flow pattern with the 3D cases'
+topology code, keeps ``DIR/history.csv`` (the same columns) and ``DIR/log.thin-film`` (a line
+a transit), and stops when the 3D runs' steady-state test passes over
+``thin_film.steady_window`` transits while the mean outflow over them meets the supply within
+``run.steady_tolerance`` (:func:`~ehlfoam.run.thin_film_record.thin_film_steady`). It ends
+with ``DIR/state.npz`` (the model's state: it starts a 3D case, ``ehlfoam case SPEC
+--start-from DIR/state.npz``, another thin-film case, or this one again) and the metrics
+record. End reasons, as the 3D runs': ``steady``, ``end_time`` (``run.end_time`` or
+``run.transits_max`` transits), ``wall_limit``, ``diverged`` (the march failed: the
+traceback in the log, no state written) and ``interrupted`` (Ctrl-C or SIGTERM; the state
+is written).
+
+A case that ran before goes on from its ``state.npz`` (its earlier samples count for the
+steady-state test); ``extend_transits`` marches that many transits past it whatever the
+test says. The oil balance covers this run: from the state it started from to the end,
+exact (the model conserves the oil to round-off).
+"""
+
+from __future__ import annotations
+
+import fcntl
+import math
+import signal
+import time
+import traceback
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ehlfoam.case.geometry import META, CaseGeometry, load_geometry, load_spec_of
+from ehlfoam.case.thin_film import START
+from ehlfoam.gap.field import GapField
+from ehlfoam.metrics.record import MetricsRecord, read_metrics, write_metrics
+from ehlfoam.run.fields import Sample
+from ehlfoam.run.history import write_history
+from ehlfoam.run.thin_film_record import (Accounts, earlier_samples, sample, thin_film_record,
+                                          thin_film_steady)
+from ehlfoam.spec.case import CaseSpec
+from ehlfoam.thinfilm.from_spec import problem_from_spec, scene_options
+from ehlfoam.thinfilm.march import Marcher
+from ehlfoam.thinfilm.solution import ThinFilmSolution
+from ehlfoam.thinfilm.state import load_state, save_state
+
+__all__ = ["STATE_FILE", "run_thin_film_case"]
+
+#: the state a thin-film run ends with, in the case folder
+STATE_FILE = "state.npz"
+#: lines of the log a failed run's record keeps
+LOG_TAIL_LINES = 20
+
+OnSample = Callable[[Sample, CaseGeometry], None]
+
+
+def run_thin_film_case(case: str | Path, *, wall_limit: float | None = None,
+                       on_sample: OnSample | None = None,
+                       extend_transits: float | None = None,
+                       busy: type[Exception] = RuntimeError) -> MetricsRecord:
+    """March the thin-film case in ``case`` to its balance (or a limit) and write its
+    metrics.json, history.csv, state.npz and log. ``wall_limit`` [s]: by default the
+    spec's ``run.wall_limit``; ``extend_transits``: march that many transits past the state
+    the case has, whatever the steady-state test says; ``busy``: the exception raised when
+    another process runs the case (the run monitor's). Returns the record written."""
+    if extend_transits is not None and not extend_transits > 0:
+        raise ValueError(f"extend_transits = {extend_transits!r} transits: it must be > 0")
+    path = Path(case).absolute()
+    spec, geom = load_spec_of(path), load_geometry(path)
+    lock = open(path / META / "run.lock", "w")
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        lock.close()
+        raise busy(f"case {path} is being run by another process") from None
+    try:
+        return _run_locked(path, spec, geom, wall_limit or spec.run.wall_limit, on_sample,
+                           extend_transits)
+    finally:
+        lock.close()
+
+
+def _start(path: Path) -> tuple[ThinFilmSolution | None, float, list[Sample], float | None]:
+    """Where the run starts: (the state, its time [s], the samples before it, the oil at
+    t = 0 [m3, whole contact] when an earlier run knew it). An earlier run's state.npz, else
+    the state the case was written to start from, else the spec's puddle (None)."""
+    if (path / STATE_FILE).is_file():
+        sol = load_state(path / STATE_FILE)
+        try:
+            initial = read_metrics(path).get("oil_volume_initial_m3")
+        except (OSError, ValueError):
+            initial = None
+        return sol, sol.time, [s for s in earlier_samples(path) if s.time <= sol.time], initial
+    if (path / META / START).is_file():
+        return load_state(path / META / START), 0.0, [], None
+    return None, 0.0, [], None
+
+
+def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
+                on_sample: OnSample | None, extend: float | None) -> MetricsRecord:
+    write_metrics(path, MetricsRecord(status="running", cells=geom.cells))
+    prob = problem_from_spec(spec, GapField.load(path / "precalc"), scene_options(spec))
+    start, t0, history, initial = _start(path)
+    m = Marcher(prob, start=start, courant=spec.thin_film.courant,
+                transit_length=spec.run.transit_length * spec.a)
+    end_time = t0 + extend * geom.transit_time if extend else spec.end_time
+    n_steps = max(0, math.ceil((end_time - t0) / m.dt - 1e-6))
+    write_every = max(1, round(m.steps_per_transit / spec.run.writes_per_transit))
+    window = spec.thin_film.steady_window * geom.transit_time
+    log = _Log(path / geom.log_name, spec, geom, m, t0)
+    first = before = Accounts.of(m, t0)
+    oil_start = m.oil()
+    reason, kind, failure = None, None, None
+    t_wall = time.monotonic()
+    previous = signal.getsignal(signal.SIGTERM)
+    handled = _on_sigterm()
+    try:
+        while m.steps < n_steps:
+            try:
+                m.step()
+                if not np.isfinite(m.c).all():
+                    raise FloatingPointError("the oil content is no longer finite")
+            except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
+                failure = err
+                break
+            if m.steps % write_every == 0 or m.steps == n_steps:
+                s, before = sample(m, t0, geom, before)
+                history.append(s)
+                if on_sample:
+                    on_sample(s, geom)
+                kind = None if extend else thin_film_steady(
+                    history, window, spec.run.steady_tolerance, spec.run.transit_length)
+            if m.steps % m.steps_per_transit == 0:
+                log.transit(m, t0, history[-1] if history else None)
+                write_history(path, history)
+            if kind:
+                reason = "steady"
+                break
+            if time.monotonic() - t_wall > wall_limit:
+                reason = "wall_limit"
+                break
+    except KeyboardInterrupt:
+        reason = "interrupted"
+    finally:
+        if handled:
+            signal.signal(signal.SIGTERM, previous)
+    wall = time.monotonic() - t_wall
+    if failure is not None:
+        reason, tail = "diverged", log.failure(failure)
+    else:
+        reason, tail = reason or "end_time", None
+        if not history or history[-1].time < t0 + m.time * (1 - 1e-9):
+            s, before = sample(m, t0, geom, before)
+            history.append(s)
+        save_state(m.solution(reason == "steady"), path / STATE_FILE)
+    write_history(path, history)
+    log.end(reason, wall)
+    status = {"diverged": "failed", "interrupted": "interrupted"}.get(reason, "finished")
+    record = thin_film_record(
+        geom, history, status=status, reason=reason, steady_kind=kind, start=first,
+        end=Accounts.of(m, t0), oil_start=oil_start, oil_end=m.oil(),
+        oil_initial=initial if initial is not None else 2.0 * oil_start, steps=m.steps,
+        dt=m.dt, wall_s=wall, log_tail=tail)
+    write_metrics(path, record)
+    return record
+
+
+def _on_sigterm() -> bool:
+    """SIGTERM raises KeyboardInterrupt (the run ends ``interrupted``, its state written);
+    False where signals cannot be set (not the main thread)."""
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+    try:
+        signal.signal(signal.SIGTERM, interrupt)
+    except ValueError:
+        return False
+    return True
+
+
+class _Log:
+    """``log.thin-film``: what was marched (a header), a line a transit, how it ended. An
+    earlier run's log is kept, renamed with its time."""
+
+    def __init__(self, path: Path, spec: CaseSpec, geom: CaseGeometry, m: Marcher,
+                 t0: float):
+        if path.exists():
+            path.rename(path.with_name(f"{path.name}.{int(time.time())}"))
+        self.path, self.transit_s = path, geom.transit_time
+        p_cav = m.prob.cavitation_pressure
+        self._write(f"ehlfoam thin-film run of {spec.name}: {len(m.grid.x)} x "
+                    f"{len(m.grid.y)} cells of {m.grid.cell / geom.a:g} a ({geom.cells} outside "
+                    f"the island), step {m.dt:.4g} s ({m.steps_per_transit} a transit), "
+                    f"cavitation pressure {'none' if p_cav is None else f'{p_cav:g} Pa gauge'}, "
+                    f"from t = {t0:.6g} s")
+
+    def _write(self, line: str) -> None:
+        with open(self.path, "a") as fh:
+            fh.write(line + "\n")
+
+    def transit(self, m: Marcher, t0: float, s: Sample | None) -> None:
+        rec = m.history[-1]
+        p = s.pattern if s else {}
+
+        def fmt(v):
+            return "-" if v is None else f"{v:.2f}"
+        self._write(f"transit {(t0 + m.time) / self.transit_s:7.2f}: t = {t0 + m.time:.6g} s, "
+                    f"oil {2e12 * rec['oil_m3']:.2f} nl in the region, out / in "
+                    f"{rec['outflow_over_supply']:.3f}, state {p.get('state')}, inlet "
+                    f"{fmt(p.get('inlet_meniscus_distance_over_a'))} a, width "
+                    f"{fmt(p.get('flooded_width_over_a'))} a, bubble "
+                    f"{fmt(p.get('bubble_length_over_a'))} a, {rec['cavity_cells']} cavity "
+                    f"cells, {rec['cells_opened_to_gas']} opened to gas, "
+                    f"{rec['cells_opened_dry']} ran dry")
+
+    def failure(self, err: BaseException) -> list[str]:
+        """Log the traceback; the log's last lines."""
+        self._write("".join(traceback.format_exception(err)).rstrip())
+        return self.path.read_text(errors="replace").splitlines()[-LOG_TAIL_LINES:]
+
+    def end(self, reason: str, wall: float) -> None:
+        self._write(f"end: {reason} after {wall:.1f} s")
