@@ -16,6 +16,20 @@ SMALL = {
     "run": {"end_time": 1e-3, "writes_per_transit": 1000},
 }
 
+#: The tiny thin-film case (issue 74): SMALL's contact and supply in the gap-averaged model,
+#: on 0.33 a cells over a small domain, gas released below 90 kPa (a bubble behind the
+#: contact): builds in a second, comes to rest in some 10 transits, seconds on one core.
+THIN_FILM = {
+    "name": "tf",
+    "scene": "thin-film",
+    "contact": SMALL["contact"],
+    "domain": {"upstream": 5.0, "downstream": 8.0, "side": 5.0},
+    "supply": SMALL["supply"],
+    "physics": {"cavitation_pressure": 9e4},
+    "thin_film": {"cell": 0.33, "steady_window": 3},
+    "run": {"transits_max": 30.0, "writes_per_transit": 2},
+}
+
 
 def tiny_geometry(**kw) -> CaseGeometry:
     """A :class:`CaseGeometry` of a made-up case (a = 0.1 mm, transit 0.1 s, 3 cells),
