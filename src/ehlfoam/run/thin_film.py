@@ -101,9 +101,9 @@ def _start(path: Path) -> tuple[ThinFilmSolution | None, float, list[Sample], fl
 
 def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
                 on_sample: OnSample | None, extend: float | None) -> MetricsRecord:
+    start, t0, history, initial = _start(path)       # before metrics.json says running
     write_metrics(path, MetricsRecord(status="running", cells=geom.cells))
     prob = problem_from_spec(spec, GapField.load(path / "precalc"), scene_options(spec))
-    start, t0, history, initial = _start(path)
     m = Marcher(prob, start=start, courant=spec.thin_film.courant,
                 transit_length=spec.run.transit_length * spec.a)
     end_time = t0 + extend * geom.transit_time if extend else spec.end_time
