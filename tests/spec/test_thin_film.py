@@ -50,7 +50,7 @@ def test_the_cell_is_the_levels_unless_given(level):
                                     '"thin-film": must be in [0, 90) deg'),
     ("physics.cavitation_pressure", 1e5, None),
     ("thin_film.normal_length", 0.01, "thin_film.normal_length = 0.01 a is out of range: must "
-                                      "be none or in [0.05, 3.25] a"),
+                                      "be none or in [0.1, 3.25] a"),
     ("thin_film.advancing_angle", 10.0, "thin_film.advancing_angle = 10 deg is out of range: "
                                         "must be none or in [15, 90) deg"),
     ("thin_film.receding_meniscus", 3.0, 'must be "static", "bretherton" or a factor in '

@@ -29,9 +29,11 @@ CaseSpec = Any
 __all__ = ["THIN_FILM_CELLS", "THIN_FILM_MAX_CELLS", "THREE_D_ONLY", "ThinFilm",
            "check_thin_film", "thin_film_cell", "thin_film_cells", "thin_film_cpu_s"]
 
-#: The thin-film grid's square cells per mesh level [a]. The nominal inlet meniscus, width
-#: and bubble move by less than ... between ... and ... (docs/models/thin-film.md#grid-levels).
-THIN_FILM_CELLS: dict[str, float] = {"coarse": 0.2, "medium": 0.1, "fine": 0.05}
+#: The thin-film grid's square cells per mesh level [a]. On the nominal thin-film case
+#: (docs/models/thin-film.md#grid-levels) medium is within 1 % of fine in the inlet meniscus
+#: and the width and 7 % short in the bubble, in 45 s of one core; coarse within 5 % in the
+#: width and 10 % in the bubble, in 10 s; fine some 6 minutes from a puddle.
+THIN_FILM_CELLS: dict[str, float] = {"coarse": 0.4, "medium": 0.2, "fine": 0.1}
 
 #: The most cells a thin-film grid may have (a 0.02 a grid over the default domain has
 #: 520,000): a step solves the pressure on all of them.
@@ -67,7 +69,7 @@ class ThinFilm(BaseModel):
     cell: float | None = Field(
         None, ge=0.01, le=10.0,
         description="Size of the model's square cells; none: the level's "
-                    "(THIN_FILM_CELLS[mesh.resolution]: coarse 0.2, medium 0.1, fine 0.05 a). "
+                    "(THIN_FILM_CELLS[mesh.resolution]: coarse 0.4, medium 0.2, fine 0.1 a). "
                     "At most half the domain's side and an eighth of its length.",
         json_schema_extra={"unit": "a"})
     film_factor: float = Field(
