@@ -56,7 +56,9 @@ from ehlfoam.errors import SpecError, format_validation_error
 
 __all__ = ["BatchSpec", "Ramp", "SpecError", "Sweep", "load_batch_spec", "parse_batch_spec"]
 
-_STRICT = ConfigDict(extra="forbid", frozen=True)
+#: unknown keys refused, frozen, strict types (no true or "25" for a number); the swept
+#: values are validated by the case spec itself, strictly too
+_STRICT = ConfigDict(extra="forbid", frozen=True, strict=True)
 
 RANGE_HELP = ("a list [0.005, 0.008] or a range {start = 0.005, stop = 0.025, num = 5} "
               "(or step = 0.005; spacing = \"log\")")
@@ -222,7 +224,7 @@ class Ramp(BaseModel):
     other, each starting from the previous step's final fields; other case-spec keys at
     single values."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True, strict=True)
     name: str = Field(pattern=r"^[A-Za-z0-9]{1,16}$",
                       description="Letters and digits, used in the case ids (rampA_up03_...)",
                       json_schema_extra={"unit": ""})
