@@ -14,8 +14,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from ehlfoam.cli.common import (EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, add_command,
-                                positive_int)
+from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_OK, add_command, positive_int
 
 DESCRIPTION = (
     "Expand a batch spec (a base case spec plus sweeps over speed, temperature, load, supply "
@@ -69,6 +68,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
+def check_batch_folder(spec: str, out: str | None, *, writes: bool = True) -> Path:
+    """The batch folder (``--out``, else runs/STEM/), checked before anything is built: a
+    path OpenFOAM can take (its cases are under it) and, with ``writes``, one that can be
+    written. Raises :class:`~ehlfoam.errors.SpecError` naming it, the path and why."""
+    from ehlfoam.batch.folder import batch_folder
+    from ehlfoam.paths import check_case_out
+
+    folder = batch_folder(Path(spec), Path(out) if out else None)
+    check_case_out(folder, "--out" if out else "batch folder", writes=writes)  # ids are safe
+    return folder
+
+
 def cmd_batch(args: argparse.Namespace) -> int:
     """Run (or dry-run) the batch; exit code as in the module doc."""
     from ehlfoam.errors import SpecError
@@ -77,6 +88,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
     from ehlfoam.batch.executors import parse_slurm
     from ehlfoam.report import after_batch
 
+    check_batch_folder(args.spec, args.out, writes=not args.dry_run)
     try:
         if args.dry_run:
             print(dry_run(args.spec, Path(args.out) if args.out else None))
@@ -96,15 +108,14 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m ehlfoam.cli.batch SPEC [options]`` (the same as ``ehlfoam batch``)."""
+    from ehlfoam.cli.failures import run_command
+
     parser = add_parser(argparse.ArgumentParser(prog="ehlfoam").add_subparsers())
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:
         return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
-    try:
-        return cmd_batch(args)
-    except KeyboardInterrupt:
-        return EXIT_INTERRUPTED
+    return run_command(args, "batch", parser)
 
 
 if __name__ == "__main__":

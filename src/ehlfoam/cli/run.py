@@ -1,7 +1,8 @@
 """``ehlfoam run``: run a case to steady state and write its metrics.json.
 
 Exit codes: 0 finished, 1 failed or stopped short (metrics.json says why), 2 bad input (no
-such case, or a case another process is running).
+such case, not a case, a corrupt case file, a path OpenFOAM cannot take, a read-only or full
+disk, or a case another process is running; found before anything is written).
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import json
 import sys
 
 from ehlfoam.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, add_command,
-                                positive_float, print_notices)
+                                check_case, positive_float, print_notices)
 
 #: the metrics printed as the command's JSON line
 KEYS = ("status", "end_reason", "state", "inlet_meniscus_distance_over_a",
@@ -41,7 +42,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """Run a generated case, print its main metrics as one JSON line and its notices."""
+    """Check the case, run it, print its main metrics as one JSON line and its notices."""
+    check_case(args.case, "CASE", writes=True)
+    check_control_dict(args.case)
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from ehlfoam.notices import from_text
@@ -70,6 +73,29 @@ def cmd_run(args: argparse.Namespace) -> int:
     print(json.dumps({k: metrics.get(k) for k in KEYS}))
     print_notices("run", from_text(metrics.get("warnings")))
     return EXIT_OK if metrics["status"] == "finished" else EXIT_FAILURE
+
+
+def check_control_dict(case) -> None:
+    """The case's ``system/controlDict``, which the run edits (stopAt, endTime), must read as
+    an OpenFOAM dictionary: :class:`~ehlfoam.errors.SpecError` naming it, before anything is
+    written."""
+    from pathlib import Path
+
+    from foamlib import FoamFile
+
+    from ehlfoam.cli.failures import foam_parse_text
+    from ehlfoam.errors import SpecError
+
+    path = Path(case) / "system" / "controlDict"
+    if not path.is_file():
+        raise SpecError(f"CASE {case}: it has no system/controlDict (not a complete case; "
+                        f"write it again with ehlfoam case SPEC --out {case} --overwrite)")
+    try:
+        FoamFile(path).as_dict()
+    except ValueError as err:   # foamlib's FoamFileDecodeError, a UnicodeDecodeError
+        raise SpecError(f"CASE {case}: system/controlDict is not a valid OpenFOAM dictionary "
+                        f"({foam_parse_text(err)}); write the case again with ehlfoam case SPEC --out {case} "
+                        f"--overwrite") from None
 
 
 def sample_line(sample, geom) -> str:
