@@ -49,10 +49,12 @@ if __name__ == "__main__":
 
 def _label(name: str, path: str | os.PathLike) -> str:
     """How a message names the path: ``--out DIR`` (an option), ``CASE DIR`` (an argument) or
-    ``out = 'DIR'`` (a keyword of the Python API)."""
+    ``out = 'DIR'`` (a keyword of the Python API); a path with a line break or another
+    control character quoted, so that the message stays one line."""
+    text = str(path)
     if name.startswith("-") or name.isupper():
-        return f"{name} {path}"
-    return f"{name} = {str(path)!r}"
+        return f"{name} {text if text.isprintable() else repr(text)}"
+    return f"{name} = {text!r}"
 
 
 def _error(message: str) -> Exception:

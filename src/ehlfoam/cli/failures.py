@@ -184,7 +184,7 @@ def explain(exc: BaseException, command: str, args: argparse.Namespace | None = 
     if isinstance(exc, OSError):
         user = exc.errno in USER_ERRNOS or (not exc.errno and isinstance(exc, USER_OS_ERRORS))
         code = EXIT_BAD_INPUT if user else EXIT_FAILURE
-        return code, _os_error(exc, command, args, parser)
+        return code, one_line(_os_error(exc, command, args, parser))
     if isinstance(exc, ValueError):
         return EXIT_BAD_INPUT, one_line(exc)
     if isinstance(exc, MemoryError):
