@@ -33,7 +33,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The batch command's arguments."""
     p.add_argument("spec", help="batch spec TOML (e.g. examples/batches/default.toml)")
     p.add_argument("--out", default=None,
-                   help="batch folder (default: runs/STEM/ in the working directory for STEM.toml)")
+                   help="batch folder (default: runs/STEM/ in the working directory for "
+                        "STEM.toml); its path may not hold whitespace, quotes, a backslash or "
+                        "any of *?[]{}$;<>|&` (OpenFOAM cannot take them)")
     p.add_argument("--rerun-failed", action="store_true",
                    help="re-run failed cases (finished cases are never recomputed)")
     size = p.add_mutually_exclusive_group()

@@ -29,13 +29,17 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         subparsers, "case", help="write an OpenFOAM case from a case spec (TOML)",
         description="Validate the case spec, solve (or reuse) its EHL precalc, mesh the gap "
                     "around the contact and write a complete OpenFOAM case that also runs by "
-                    "hand (DIR/Allrun). Exit 2 on a bad spec, before anything is written.",
+                    "hand (DIR/Allrun). Exit 2 on bad input (the spec, --set, an --out that "
+                    "cannot be written or whose path OpenFOAM cannot take), before anything "
+                    "is written (docs/cli.md).",
         examples=["ehlfoam case examples/cases/nominal.toml --out runs/nominal "
                   "--set mesh.resolution=coarse",
                   "ehlfoam case examples/cases/nominal.toml --out runs/u17 "
                   "--set contact.speed=0.017 --start-from runs/nominal"])
     p.add_argument("spec", nargs="?", help="case spec TOML (default: the reference case)")
-    p.add_argument("--out", required=True, help="case folder to write")
+    p.add_argument("--out", required=True,
+                   help="case folder to write; its path may not hold whitespace, quotes, a "
+                        "backslash or any of *?[]{}$;<>|&` (OpenFOAM cannot take them)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
     p.add_argument("--overwrite", action="store_true", help="replace an existing case")
     p.add_argument("--start-from", default=None, metavar="CASE|SNAPSHOT.npz|STATE.npz",

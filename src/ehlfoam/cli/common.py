@@ -48,7 +48,7 @@ EXIT_CODES: tuple[tuple[int, str, str], ...] = (
     (EXIT_INTERNAL, "internal error",
      "a bug in ehlfoam: one line; `ehlfoam --debug COMMAND ...` shows the traceback"),
     (EXIT_INTERRUPTED, "interrupted",
-     "Ctrl-C or SIGTERM; a batch resumes when run again"),
+     "Ctrl-C (SIGTERM too in run and batch); a batch resumes when run again"),
 )
 
 

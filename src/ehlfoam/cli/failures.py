@@ -14,7 +14,7 @@ failed run, a precalc that did not converge) and raises for everything else:
   read-only disk, ...: :data:`USER_ERRNOS`), named by the option whose path it is
   (``--out /x: read-only file system``), and an OpenFOAM configuration error;
 - failed (exit 1): an OpenFOAM application that failed, another OS error, no memory left;
-- interrupted (exit 130): Ctrl-C (SIGTERM is turned into it by the commands that run long);
+- interrupted (exit 130): Ctrl-C (``run`` and ``batch`` turn SIGTERM into it);
 - internal error (exit 70): anything else, a bug: its type and text on one line.
 
 The module imports only the standard library; the exception classes of pydantic, foamlib and
