@@ -7,7 +7,6 @@ that does not fit; nothing left written).
 from __future__ import annotations
 
 import argparse
-import shutil
 import sys
 from collections.abc import Iterable
 from typing import Any
@@ -105,13 +104,11 @@ def _write(spec, args: argparse.Namespace) -> int:
                                         overwrite=args.overwrite)
     except CaseExists as err:
         return _bad(err)
-    except RampError as err:   # found only on the new mesh: leave no half-made case
-        shutil.rmtree(args.out, ignore_errors=True)
+    except RampError as err:   # found only on the new mesh: no case was written
         return _bad(f"--start-from {args.start_from}: {err}")
     except ValueError as err:   # mesh.follow: the source has no meniscus to follow
         if spec.mesh.follow is None:
             raise
-        shutil.rmtree(args.out, ignore_errors=True)
         return _bad(f"--start-from {args.start_from}: {err}")
     if seed is not None:
         at = ("" if seed["previous_time_s"] is None
