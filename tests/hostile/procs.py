@@ -45,7 +45,7 @@ def tree(root: int) -> dict[int, int]:
     return out
 
 
-def _cmdline(pid: int) -> str:
+def command_line(pid: int) -> str:
     try:
         return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(
             errors="replace").strip()
@@ -54,7 +54,7 @@ def _cmdline(pid: int) -> str:
 
 
 def _describe(pid: int) -> str:
-    return f"{pid} {_cmdline(pid)[:160]}"
+    return f"{pid} {command_line(pid)[:160]}"
 
 
 def alive(procs: dict[int, int]) -> list[str]:
@@ -82,7 +82,7 @@ def working_in(folders: list[Path]) -> list[str]:
             cwd = os.readlink(f"/proc/{pid}/cwd")
         except OSError:
             cwd = ""
-        cmd = _cmdline(pid)
+        cmd = command_line(pid)
         if any(cwd == r or cwd.startswith(r + "/") or r in cmd for r in roots):
             out.append(_describe(pid))
     return out

@@ -22,7 +22,6 @@ import fcntl
 import json
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import time
@@ -82,7 +81,7 @@ contact = { speed = 0.02, grid = 129, tol_residual = 1e-4 }
 mesh = { resolution = "coarse", size_rim = 0.25, size_far = 1.2, n_layers = 3, wall_grading = 3.0 }
 domain = { upstream = 5.0, downstream = 7.0, side = 5.0 }
 supply = { mode = "layers", disc_layer = 3e-6, ball_layer = 3e-6, track_half_width = 2.5e-4, initial_puddle = 3.0 }
-run = { end_time = 5e-3, writes_per_transit = 100, n_procs = NPROCS }
+run = { end_time = 3e-3, writes_per_transit = 250, n_procs = NPROCS }
 """
 
 
@@ -177,13 +176,26 @@ def kill_when(proc: subprocess.Popen, ready: Callable[[], bool], what: str,
     if after:
         time.sleep(after)
     tree = procs.tree(proc.pid)
+    TREES.append(tree)
+    COMMANDS.update({pid: procs.command_line(pid) for pid in tree})
     proc.kill()
-    proc.communicate(timeout=30)
+    try:
+        proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:   # its output pipe is held open by a survivor
+        raise AssertionError(f"processes of the killed command survive (its output stays "
+                             f"open): {procs.survivors(tree, [], timeout=0)}") from None
     return tree
 
 
+#: the command lines of the processes of the trees taken (read before they are killed)
+COMMANDS: dict[int, str] = {}
+#: the trees taken, for the clean-up after a failed scenario
+TREES: list[dict[int, int]] = []
+
+
 def solver_pids(tree: dict[int, int]) -> list[int]:
-    return [p for p in tree if "interFoam" in procs._cmdline(p)]
+    return [p for p in tree
+            if "interFoam" in COMMANDS.get(p, "") or "interFoam" in procs.command_line(p)]
 
 
 # ------------------------------------------------------------------ refusals
@@ -335,7 +347,7 @@ def run_sigkill_serial(tmp: Path, lab: Lab) -> Result:
     case = lab.case(tmp)
     proc = start("run", "case", "--quiet", cwd=tmp)
     tree = kill_when(proc, lambda: times(case) >= 2, "two writes")
-    assert solver_pids(tree), tree
+    assert solver_pids(tree), [COMMANDS.get(p) for p in tree]
     return _after_run_kill(tmp, case, tree, "run, solver serial")
 
 
@@ -343,8 +355,17 @@ def run_sigkill_mpi(tmp: Path, lab: Lab) -> Result:
     case = lab.case(tmp, "long2", n_procs=2)
     proc = start("run", "case", "--quiet", cwd=tmp)
     tree = kill_when(proc, lambda: times(case / "processor0") >= 2, "two writes of the ranks")
-    assert len(solver_pids(tree)) >= 2, tree
+    assert len(solver_pids(tree)) >= 2, [COMMANDS.get(p) for p in tree]
     return _after_run_kill(tmp, case, tree, "run, solver on 2 ranks")
+
+
+def _holds(pid: int, path: str) -> bool:
+    """The process has ``path`` open (it holds the flock taken on it)."""
+    try:
+        return any(os.readlink(f"/proc/{pid}/fd/{fd}") == path
+                   for fd in os.listdir(f"/proc/{pid}/fd"))
+    except OSError:
+        return False
 
 
 def run_concurrent(tmp: Path, lab: Lab) -> Result:
@@ -359,14 +380,17 @@ def run_concurrent(tmp: Path, lab: Lab) -> Result:
     tree = procs.tree(first.pid)
     solvers = solver_pids(tree)
     lock = str(case / META / "run.lock")
-    assert solvers and all(lock in {os.readlink(f"/proc/{s}/fd/{fd}")
-                                    for fd in os.listdir(f"/proc/{s}/fd")} for s in solvers)
+    assert solvers and all(_holds(s, lock) for s in solvers), "the solver has no run lock"
     first.kill()
     first.communicate(timeout=30)
-    while procs.alive({s: tree[s] for s in solvers}):
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
         held = run_lock_held(case)
-        if procs.alive({s: tree[s] for s in solvers}):
-            assert held, "a solver lives and the run lock is free"
+        holders = [s for s in solvers if _holds(s, lock)]   # after the probe: they held it
+        if not holders:
+            break
+        assert held, f"solvers {holders} live with the run lock open and it is free"
+        time.sleep(0.01)
     assert not run_lock_held(case)
     return Result(second.returncode, second.stderr, tree, [tmp])
 
@@ -424,6 +448,31 @@ def run_stale_decomposition(tmp: Path, lab: Lab) -> Result:
     m = json.loads((case / "metrics.json").read_text())
     assert m["status"] == "finished", m
     return Result(p.returncode, p.stderr + m["end_reason"])
+
+
+def run_kill_at_start(tmp: Path, lab: Lab) -> Result:
+    """SIGKILL while the run decomposes the case (before the solver starts)."""
+    case = lab.case(tmp, "long2", n_procs=2)
+    proc = start("run", "case", "--quiet", cwd=tmp)
+    tree = kill_when(proc, lambda: (case / "log.decomposePar").exists(), "decomposePar")
+    return _after_run_kill(tmp, case, tree, "run, decomposing before the solver")
+
+
+def case_kill_during_overwrite(tmp: Path, lab: Lab) -> Result:
+    """SIGKILL of `ehlfoam case --overwrite` while it writes the new case: the earlier case
+    stays whole; the same command again replaces it and clears the dead build."""
+    case = lab.case(tmp)
+    before = snapshot_of_folder(case)
+    spec = lab.spec_file(tmp)
+    proc = start("case", str(spec), "--out", "case", "--overwrite", cwd=tmp)
+    tree = kill_when(proc, lambda: any(tmp.glob(".case.*")), "the new case being written")
+    assert snapshot_of_folder(case) == before, "the earlier case was touched"
+    resume = cli("case", str(spec), "--out", "case", "--overwrite", cwd=tmp)
+    assert (case / META / MARKER).is_file() and snapshot_of_folder(case) != before
+    nothing_beside(tmp, {"case", "spec.toml"})
+    matrix = (f"case --overwrite, writing the new case: processes left 0, the earlier case "
+              f"whole, resume exit {resume.returncode}")
+    return Result(resume.returncode, resume.stdout + resume.stderr, tree, [tmp], matrix)
 
 
 # ------------------------------------------------------------------ batches
@@ -572,6 +621,13 @@ SCENARIOS = [
     _row("run-sigkill-2-ranks", "run CASE (run.n_procs = 2); SIGKILL; run CASE again", 0,
          ["monitor_killed"], "the case; metrics.json finished after the resume",
          run_sigkill_mpi, OF, NEEDS_ROOT),
+    _row("run-kill-at-start", "run CASE (n_procs 2); SIGKILL during decomposePar; run CASE "
+         "again", 0, ["monitor_killed"], "the case; metrics.json finished after the resume",
+         run_kill_at_start, OF, SLOW, NEEDS_ROOT),
+    _row("case-kill-during-overwrite", "case SPEC --out CASE --overwrite; SIGKILL while the "
+         "new case is written; the same again", 0, ["case", "cells"],
+         "the earlier case whole, then the new one; no temporary folder",
+         case_kill_during_overwrite),
     _row("run-concurrent", "run CASE twice at once; case --overwrite meanwhile; SIGKILL of "
          "the first while its solver holds the lock", 2, ["being run", "run.lock"],
          "the first run's case", run_concurrent, OF),
@@ -628,5 +684,6 @@ def test_hostile_process_scenario(row: Hostile, lab: Lab, tmp_path: Path) -> Non
         if result.matrix:
             print(f"KILL MATRIX | {result.matrix}")
     finally:
-        if result is not None:
-            procs.kill_all(result.procs)
+        for tree in TREES:
+            procs.kill_all(tree)
+        TREES.clear()

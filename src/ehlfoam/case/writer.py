@@ -23,6 +23,7 @@ import os
 import shlex
 import shutil
 import tempfile
+import time
 from dataclasses import asdict
 from collections.abc import Callable
 from pathlib import Path
@@ -43,6 +44,8 @@ from ehlfoam.mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extru
 from ehlfoam.spec.case import CaseSpec
 
 TEMPLATES = Path(__file__).resolve().parent / "templates"
+#: In a case being built (a temporary folder beside its place): the builder's pid.
+BUILDER = ".ehlfoam-build"
 
 __all__ = ["CaseBeingRun", "CaseExists", "case_mesh", "extrude_level", "write_case"]
 
@@ -133,7 +136,9 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         open_inflow_oil=1.0 if spec.fills_domain else 0.0)
 
     out.parent.mkdir(parents=True, exist_ok=True)
+    _recover(out)
     tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))
+    (tmp / BUILDER).write_text(f"{os.getpid()}\n")
     try:
         shutil.copytree(TEMPLATES / _template_for(spec), tmp, dirs_exist_ok=True)
         write_polymesh(mesh, tmp)
@@ -149,11 +154,38 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         write_marker(tmp)
         if prepare is not None:
             prepare(tmp)
+        (tmp / BUILDER).unlink()
         _swap_into_place(tmp, out, overwrite)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return geom
+
+
+def _alive(pid_file: Path) -> bool:
+    """The process named in ``pid_file`` (a build's) still runs."""
+    try:
+        os.kill(int(pid_file.read_text().split()[0]), 0)
+    except (OSError, ValueError, IndexError):
+        return False
+    return True
+
+
+def _recover(out: Path) -> None:
+    """What a write of ``out`` killed before its end left beside it: an earlier case moved
+    aside (``.NAME.old.*/case``) goes back to ``out`` if ``out`` is missing, else it is
+    removed; a temporary build folder (``.NAME.*``) whose builder died is removed."""
+    for side in sorted(out.parent.glob(f".{out.name}.*")):
+        if not side.is_dir():
+            continue
+        if side.name.startswith(f".{out.name}.old."):
+            if time.time() - side.stat().st_mtime < 60.0:   # maybe another write's, now
+                continue
+            if (side / "case").is_dir() and not out.exists():
+                os.replace(side / "case", out)
+            shutil.rmtree(side, ignore_errors=True)
+        elif (side / BUILDER).is_file() and not _alive(side / BUILDER):
+            shutil.rmtree(side, ignore_errors=True)
 
 
 def _swap_into_place(tmp: Path, out: Path, overwrite: bool) -> None:

@@ -64,9 +64,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         with progress:
             metrics = run_case(args.case, wall_limit=args.wall_limit, on_sample=on_sample,
                                extend_transits=args.extend,
-                               on_note=lambda line: progress.console.print(
-                                   f"ehlfoam run: {line}", highlight=False, soft_wrap=True,
-                                   markup=False))
+                               on_note=lambda line: print(f"ehlfoam run: {line}",
+                                                          file=sys.stderr, flush=True))
     except (CaseBusy, FileNotFoundError) as err:
         print(f"ehlfoam run: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT

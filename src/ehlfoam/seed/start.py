@@ -34,9 +34,10 @@ def _npz_members(path: Path) -> list[str]:
         with zipfile.ZipFile(path) as z:
             return [n.removesuffix(".npy") for n in z.namelist()]
     except (OSError, zipfile.BadZipFile, ValueError) as err:
-        raise RampError(f"{path} is not a readable .npz file ({err}); give a run case "
-                        "folder, a case snapshot (`ehlfoam snapshot`) or a thin-film state "
-                        "(`ehlfoam thin-film`)") from None
+        raise RampError(f"{path} is not a thin-film state nor a case snapshot: not a "
+                        f"readable .npz file ({err}); give a run case folder, a case snapshot "
+                        "(`ehlfoam snapshot`) or a thin-film state (`ehlfoam thin-film`)"
+                        ) from None
 
 
 def _check_snapshot(path: Path) -> None:
