@@ -37,16 +37,13 @@ held while any process of the run lives; the solver dies with the monitor
 
 from __future__ import annotations
 
-import bisect
 import math
 import os
-import re
 import shutil
 import signal
 import subprocess
 import threading
 import time
-from array import array
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -63,6 +60,7 @@ from ehlfoam.run.balance import (OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, dissolved
                                  mass_balance)
 from ehlfoam.run.final import RunEnd, final_record
 from ehlfoam.run.history import write_history
+from ehlfoam.run.logtail import LogTail
 from ehlfoam.run.start import (START_FAILED, StartFailed, failure_from_log, prepare_case,
                                reconstruct_new)
 from ehlfoam.run.steady import steady_test
@@ -105,55 +103,6 @@ class _Case:
 def _set_stop(case: Path, value: str) -> None:
     with FoamFile(case / "system" / "controlDict") as f:
         f["stopAt"] = value
-
-
-_STEP_OR_TIME = re.compile(r"^(deltaT|Time) = ([-+0-9.eE]+)\s*$", re.M)
-
-
-class LogTail:
-    """Incremental reader of the solver log: its time steps (each one's time and deltaT),
-    and the run of consecutive collapsed steps."""
-
-    def __init__(self, path: Path):
-        self.path, self.offset, self.small_steps = path, 0, 0
-        self.times, self.dts = array("d"), array("d")
-        self._dt = math.nan
-
-    @property
-    def steps(self) -> int:
-        return len(self.times)
-
-    @property
-    def last_dt(self) -> float:
-        return self.dts[-1] if self.dts else self._dt
-
-    @property
-    def last_time(self) -> float:
-        return self.times[-1] if self.times else math.nan
-
-    def steps_until(self, t: float) -> tuple[int, float]:
-        """(steps up to time ``t`` [s], the deltaT of the last of them)."""
-        n = bisect.bisect_right(self.times, t * (1.0 + 1e-9))
-        return n, (self.dts[n - 1] if n else math.nan)
-
-    def update(self, dt_floor: float) -> None:
-        try:
-            with open(self.path, "rb") as fh:
-                fh.seek(self.offset)
-                chunk = fh.read()
-        except FileNotFoundError:
-            return
-        cut = chunk.rfind(b"\n") + 1
-        self.offset += cut
-        text = chunk[:cut].decode("utf-8", "replace")
-        for m in _STEP_OR_TIME.finditer(text):
-            value = float(m.group(2))
-            if m.group(1) == "deltaT":
-                self._dt = value
-                self.small_steps = self.small_steps + 1 if value < dt_floor else 0
-            else:
-                self.times.append(value)
-                self.dts.append(self._dt)
 
 
 def crashed_record(case: Path, old: MetricsRecord | None = None) -> MetricsRecord | None:
