@@ -222,6 +222,15 @@ def overwrite_working_folder(tmp: Path, lab: Lab) -> Result:
     return Result(p.returncode, p.stderr)
 
 
+def case_into_empty_working_folder(tmp: Path, lab: Lab) -> Result:
+    work = tmp / "empty"
+    work.mkdir()
+    p = cli("case", str(lab.spec_file(tmp)), "--out", ".", cwd=work)
+    assert not any(work.iterdir())
+    nothing_beside(tmp, {"empty", "spec.toml"})
+    return Result(p.returncode, p.stderr)
+
+
 def overwrite_folder_holding_cwd(tmp: Path, lab: Lab) -> Result:
     case = lab.case(tmp)               # an ehlfoam case, but the working folder is inside
     sub = case / "system"
@@ -585,6 +594,8 @@ SCENARIOS = [
          overwrite_non_case),
     _row("overwrite-working-folder", "case SPEC --out . --overwrite in a working folder", 2,
          ["working folder"], "the working folder untouched", overwrite_working_folder),
+    _row("case-into-empty-working-folder", "case SPEC --out . in an empty working folder", 2,
+         ["working folder"], "the folder, empty", case_into_empty_working_folder),
     _row("overwrite-folder-holding-cwd", "case SPEC --out .. --overwrite from inside a case",
          2, ["working folder"], "the case untouched", overwrite_folder_holding_cwd),
     _row("out-is-a-file", "case SPEC --out afile --overwrite", 2, ["not a folder", "afile"],
@@ -641,7 +652,7 @@ SCENARIOS = [
          run_solver_cannot_start, OF),
     _row("run-stale-decomposition", "run CASE (n_procs 2) with decomposeParDict and "
          "processor folders for 3", 0, ["wall_limit"], "processor0, processor1",
-         run_stale_decomposition, OF, NEEDS_ROOT),
+         run_stale_decomposition, OF, SLOW, NEEDS_ROOT),
     # ---- batches: SIGKILL at six moments, then the resume
     _row("batch-kill-precalc", "batch B; SIGKILL during the EHL precalc of a new contact; "
          "batch B again", 0, ["1 cases"], "results.csv, one finished row",

@@ -131,8 +131,9 @@ def _inside(path: Path, folder: Path) -> bool:
 
 def check_replaceable(out: Path, overwrite: bool) -> None:
     """Raise :class:`CaseExists` unless a case may be written to ``out``: a folder that does
-    not exist or is empty; with ``overwrite`` also a case ehlfoam wrote, unless it is being
-    run (:class:`CaseBeingRun`) or holds the working folder. Anything else is refused
+    not exist or is empty (but not the working folder or one holding it); with ``overwrite``
+    also a case ehlfoam wrote, unless it is being run (:class:`CaseBeingRun`). Anything else
+    is refused
     (:class:`NotACase`): ``--overwrite`` never empties a folder the tool did not make."""
     out = Path(out)
     if not out.exists() and not out.is_symlink():
@@ -140,15 +141,15 @@ def check_replaceable(out: Path, overwrite: bool) -> None:
     if not out.is_dir():
         raise CaseExists(f"--out {out}: exists and is not a folder; give a new or empty "
                          "folder, or an earlier case with --overwrite")
+    real, cwd = out.resolve(), Path.cwd().resolve()
+    if _inside(cwd, real):
+        raise NotACase(f"--out {out}: {real} is the working folder or holds it; it is never "
+                       "replaced. Give the case's own folder (e.g. --out runs/NAME)")
     if not any(out.iterdir()):
         return
     if not overwrite:
         raise CaseExists(f"output folder {out} exists and is not empty (use --overwrite to "
                          "replace an earlier case written by ehlfoam)")
-    real, cwd = out.resolve(), Path.cwd().resolve()
-    if _inside(cwd, real):
-        raise NotACase(f"--out {out} --overwrite: {real} is the working folder or holds it; "
-                       "it is never replaced. Give the case's own folder from outside it")
     if not is_own_case(out):
         raise NotACase(f"--out {out} --overwrite: {real} is not a case written by ehlfoam "
                        f"(no {META}/{MARKER}) and not empty; --overwrite replaces only an "
