@@ -111,7 +111,7 @@ def kill_all(procs: dict[int, int]) -> None:
 
 
 def wait_for(predicate, proc: subprocess.Popen | None, timeout: float, what: str,
-             step: float = 0.05) -> None:
+             step: float = 0.01) -> None:
     """Poll ``predicate`` until true; fail with ``what`` after ``timeout`` seconds or when
     ``proc`` ended first."""
     deadline = time.monotonic() + timeout

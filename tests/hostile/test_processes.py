@@ -170,20 +170,24 @@ def times(case: Path) -> int:
 
 
 def kill_when(proc: subprocess.Popen, ready: Callable[[], bool], what: str,
-              timeout: float = 120.0, after: float = 0.0) -> dict[int, int]:
-    """Wait for ``ready``, take the process tree, SIGKILL ``proc``; returns the tree."""
+              timeout: float = 120.0, after: float = 0.0,
+              still: Callable[[], bool] | None = None) -> dict[int, int]:
+    """Wait for ``ready``, take the process tree, SIGKILL ``proc``; returns the tree.
+    ``still``: true when the moment has not passed yet, checked right before the kill."""
     procs.wait_for(ready, proc, timeout, what)
     if after:
         time.sleep(after)
     tree = procs.tree(proc.pid)
     TREES.append(tree)
     COMMANDS.update({pid: procs.command_line(pid) for pid in tree})
+    in_time = still() if still is not None else True
     proc.kill()
     try:
         proc.communicate(timeout=30)
     except subprocess.TimeoutExpired:   # its output pipe is held open by a survivor
         raise AssertionError(f"processes of the killed command survive (its output stays "
                              f"open): {procs.survivors(tree, [], timeout=0)}") from None
+    assert in_time, f"the kill came after {what} was over"
     return tree
 
 
@@ -463,7 +467,8 @@ def run_kill_at_start(tmp: Path, lab: Lab) -> Result:
     """SIGKILL while the run decomposes the case (before the solver starts)."""
     case = lab.case(tmp, "long2", n_procs=2)
     proc = start("run", "case", "--quiet", cwd=tmp)
-    tree = kill_when(proc, lambda: (case / "log.decomposePar").exists(), "decomposePar")
+    tree = kill_when(proc, lambda: (case / "log.decomposePar").exists(), "decomposePar",
+                     still=lambda: not (case / "log.interFoam").exists())
     return _after_run_kill(tmp, case, tree, "run, decomposing before the solver")
 
 
@@ -495,12 +500,13 @@ def _batch_spec(tmp: Path, n_cases: int, n_procs: int = 1) -> Path:
 
 def _batch(tmp: Path, moment: str, ready: Callable[[Path], bool], *, n_cases: int = 1,
            n_procs: int = 1, report: bool = False, env: dict | None = None,
-           after: float = 0.0) -> Result:
+           after: float = 0.0, still: Callable[[Path], bool] | None = None) -> Result:
     spec = _batch_spec(tmp, n_cases, n_procs)
     batch = tmp / "runs" / "b"
     flags = ["--jobs", "1", "--quiet"] + ([] if report else ["--no-report"])
     proc = start("batch", str(spec), *flags, cwd=tmp, env=env)
-    tree = kill_when(proc, lambda: ready(batch), moment, after=after)
+    tree = kill_when(proc, lambda: ready(batch), moment, after=after,
+                     still=None if still is None else (lambda: still(batch)))
     left = procs.survivors(tree, [tmp])
     plan = [c["id"] for c in json.loads((batch / "plan.json").read_text())]
     cases = [batch / "cases" / cid for cid in plan]
@@ -531,17 +537,14 @@ def batch_during_precalc(tmp: Path, lab: Lab) -> Result:
     env = {**os.environ, "EHLFOAM_CACHE": str(cache)}
     return _batch(tmp, "batch, EHL precalc of a new contact",
                   lambda b: any(p.name.endswith(".lock") for p in (cache / "precalc").iterdir()),
-                  env=env, after=1.0)
-
-
-def _building(batch: Path) -> bool:
-    return any((batch / "locks").glob("*.lock")) if (batch / "locks").is_dir() else False
+                  env=env, after=1.0,
+                  still=lambda b: not any((cache / "precalc").glob("*/summary.json")))
 
 
 def batch_during_build(tmp: Path, lab: Lab) -> Result:
     return _batch(tmp, "batch, meshing and case build",
-                  lambda b: _building(b) and not list(b.glob("cases/*/metrics.json")),
-                  after=1.0)
+                  lambda b: any(b.glob("locks/*.lock")),
+                  still=lambda b: not list(b.glob(f"cases/*/{META}/{MARKER}")))
 
 
 def _solving(batch: Path, sub: str = "") -> bool:
@@ -549,12 +552,25 @@ def _solving(batch: Path, sub: str = "") -> bool:
 
 
 def batch_during_solver(tmp: Path, lab: Lab) -> Result:
-    return _batch(tmp, "batch, solver serial", _solving)
+    return _batch(tmp, "batch, solver serial", _solving,
+                  still=lambda b: not list(b.glob("cases/*/metrics.json"))
+                  or _running(b))
 
 
 def batch_during_mpi_solver(tmp: Path, lab: Lab) -> Result:
     return _batch(tmp, "batch, solver on 2 ranks", lambda b: _solving(b, "processor0"),
-                  n_procs=2)
+                  n_procs=2, still=_running)
+
+
+def _running(batch: Path) -> bool:
+    """A case's metrics.json says running (its solver has not ended)."""
+    for p in batch.glob("cases/*/metrics.json"):
+        try:
+            if json.loads(p.read_text()).get("status") == "running":
+                return True
+        except (OSError, ValueError):
+            pass
+    return False
 
 
 def _metrics_written(batch: Path) -> bool:
@@ -568,12 +584,14 @@ def _metrics_written(batch: Path) -> bool:
 
 
 def batch_during_metrics(tmp: Path, lab: Lab) -> Result:
-    return _batch(tmp, "batch, metrics of a case just written", _metrics_written, n_cases=2)
+    return _batch(tmp, "batch, metrics of a case just written", _metrics_written, n_cases=2,
+                  still=lambda b: not (b / "report").exists())
 
 
 def batch_during_report(tmp: Path, lab: Lab) -> Result:
     return _batch(tmp, "batch, report drawing (its pool)",
-                  lambda b: any(b.glob("cases/*/report")), n_cases=2, report=True)
+                  lambda b: any(b.glob("cases/*/report")), n_cases=2, report=True,
+                  still=lambda b: not (b / "report" / "index.html").exists())
 
 
 # ------------------------------------------------------------------ the table
