@@ -50,39 +50,20 @@ IS_ROOT = os.geteuid() == 0 and shutil.which("unshare") is not None
 
 #: the tiny case, run long enough (50 ms) to be killed while it runs
 LONG = {**SMALL, "run": {**SMALL["run"], "end_time": 0.05}}
-SPEC_TOML = """name = "hostile"
-[contact]
-speed = 0.02
-grid = 129
-tol_residual = 1e-4
-[mesh]
-resolution = "coarse"
-size_rim = 0.25
-size_far = 1.2
-n_layers = 3
-wall_grading = 3.0
-[domain]
-upstream = 5.0
-downstream = 7.0
-side = 5.0
-[supply]
-mode = "layers"
-disc_layer = 3e-6
-ball_layer = 3e-6
-track_half_width = 2.5e-4
-initial_puddle = 3.0
-[run]
-end_time = 1e-3
-writes_per_transit = 1000
-"""
-BATCH_BASE = """
-[base]
-contact = { speed = 0.02, grid = 129, tol_residual = 1e-4 }
-mesh = { resolution = "coarse", size_rim = 0.25, size_far = 1.2, n_layers = 3, wall_grading = 3.0 }
-domain = { upstream = 5.0, downstream = 7.0, side = 5.0 }
-supply = { mode = "layers", disc_layer = 3e-6, ball_layer = 3e-6, track_half_width = 2.5e-4, initial_puddle = 3.0 }
-run = { end_time = 3e-3, writes_per_transit = 250, n_procs = NPROCS }
-"""
+def _toml(value) -> str:
+    """A TOML value: a number, a string, or a table inline."""
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + " }"
+    return json.dumps(value) if isinstance(value, str) else repr(value)
+
+
+#: the tiny case as a case spec file
+SPEC_TOML = "\n".join(f"{k} = {_toml(v)}" for k, v in SMALL.items()) + "\n"
+#: the tiny case as a batch's [base] (3 ms, 11 writes; NPROCS: run.n_procs)
+BATCH_BASE = "[base]\n" + "\n".join(
+    f"{k} = {_toml(v)}" for k, v in {**SMALL, "name": "b", "run": {
+        "end_time": 3e-3, "writes_per_transit": 250, "n_procs": 0}}.items()
+    if k != "name").replace("n_procs = 0", "n_procs = NPROCS") + "\n"
 
 
 @dataclass

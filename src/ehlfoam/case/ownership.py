@@ -29,7 +29,7 @@ from ehlfoam.case.geometry import META
 from ehlfoam.errors import SpecError
 
 __all__ = ["MARKER", "RUN_LOCK", "CaseBeingRun", "CaseBusy", "CaseExists", "NotACase",
-           "check_replaceable", "hold_run_lock", "is_own_case", "run_lock_held",
+           "check_replaceable", "hold_run_lock", "is_own_case", "lock_held", "run_lock_held",
            "write_marker"]
 
 #: The file that marks a folder as a case ehlfoam wrote (under ``ehlfoam/``).
@@ -85,8 +85,13 @@ def is_own_case(folder: Path) -> bool:
 
 def run_lock_held(case: Path) -> bool:
     """True while a process holds ``case``'s run lock (a probe, released at once)."""
+    return lock_held(Path(case) / META / RUN_LOCK)
+
+
+def lock_held(path: Path) -> bool:
+    """True if a process holds an flock on ``path`` (a probe, released at once)."""
     try:
-        fh = open(Path(case) / META / RUN_LOCK)
+        fh = open(path)
     except OSError:
         return False
     try:
