@@ -22,9 +22,11 @@ import fcntl
 import json
 import os
 import shutil
+import struct
 import subprocess
 import sys
 import time
+import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -135,6 +137,18 @@ def start(*args: str, cwd: Path, env: dict | None = None) -> subprocess.Popen:
     return subprocess.Popen([EHLFOAM, *args], cwd=cwd, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True, env=env,
                             start_new_session=True)
+
+
+def flip_a_byte(npz: Path, member: str = "alpha.oil.npy") -> None:
+    """Flip one bit in the middle of ``member``'s compressed data (not in a header field
+    that readers ignore, such as the zip64 sizes of a local header)."""
+    with zipfile.ZipFile(npz) as z:
+        info = z.getinfo(member)
+    data = bytearray(npz.read_bytes())
+    start = info.header_offset
+    name_len, extra_len = struct.unpack("<HH", data[start + 26:start + 30])
+    data[start + 30 + name_len + extra_len + info.compress_size // 2] ^= 0x01
+    npz.write_bytes(bytes(data))
 
 
 def snapshot_of_folder(folder: Path) -> dict[str, bytes]:
@@ -257,9 +271,7 @@ def overwrite_with_bad_start(tmp: Path, lab: Lab) -> Result:
     case = lab.case(tmp)
     before = snapshot_of_folder(case)
     bad = lab.snapshot(tmp)
-    data = bytearray(bad.read_bytes())
-    data[len(data) // 2] ^= 0xFF
-    bad.write_bytes(bytes(data))
+    flip_a_byte(bad)
     p = cli("case", str(lab.spec_file(tmp)), "--out", "case", "--overwrite",
             "--start-from", str(bad), cwd=tmp)
     assert snapshot_of_folder(case) == before, "the earlier case was lost"
@@ -285,9 +297,7 @@ def start_fake_time_folder(tmp: Path, lab: Lab) -> Result:
 
 def start_flipped_snapshot(tmp: Path, lab: Lab) -> Result:
     snap = lab.snapshot(tmp)
-    data = bytearray(snap.read_bytes())
-    data[len(data) // 3] ^= 0x01
-    snap.write_bytes(bytes(data))
+    flip_a_byte(snap)
     return _start_refused(tmp, lab, snap, {"state.npz"})
 
 
