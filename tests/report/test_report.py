@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import fcntl
 import json
 import os
 import re
@@ -186,9 +187,14 @@ def test_failed_case_says_so_with_the_log_tail(finished_case, tmp_path):
 def test_running_and_never_run_cases(finished_case, tmp_path):
     running = _copy(finished_case, tmp_path / "running")
     (running / "metrics.json").write_text(json.dumps({"status": "running", "cells": 1}))
-    html = report_case(running, animate=False).read_text()
+    with open(running / "ehlfoam" / "run.lock", "a") as lock:   # a live run holds it
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        html = report_case(running, animate=False).read_text()
     assert "Status: running" in html and "still going" in html
     assert "Last lines of the solver log" in html
+    # no process holds the lock: the run was killed and left metrics.json running
+    html = report_case(running, animate=False).read_text()
+    assert "Status: interrupted" in html and "monitor_killed" in html
 
     fresh = _copy(finished_case, tmp_path / "fresh")
     for _, folder in time_folders(fresh):

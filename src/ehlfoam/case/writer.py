@@ -5,8 +5,15 @@
 The case is the template folder ``templates/<scene>/`` copied and edited with foamlib (values
 marked "set by the generator" in the templates; :mod:`.fields`, :mod:`.dictionaries`), the
 mesh written directly as a polyMesh, and ``ehlfoam/`` holding what the monitor and the
-metrics need (the spec, the geometry (:mod:`.geometry`), the mesh's 2D structure). The case
+metrics need (the spec, the geometry (:mod:`.geometry`), the mesh's 2D structure) and the
+marker ``ehlfoam/case.json`` that makes the folder the tool's own (:mod:`.ownership`). The case
 also runs by hand: ``DIR/Allrun``, ``DIR/Allclean``.
+
+The case is built in a temporary sibling folder and renamed into place only when complete
+(a start from another state is written into it first, see ``prepare``): a failure leaves
+nothing behind, and an earlier case replaced with ``overwrite`` stays whole until then.
+``overwrite`` replaces only an empty folder or a case the tool wrote, never one being run
+(:func:`.ownership.check_replaceable`).
 """
 
 from __future__ import annotations
@@ -16,7 +23,9 @@ import os
 import shlex
 import shutil
 import tempfile
+import time
 from dataclasses import asdict
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +34,8 @@ from ehlfoam._io import atomic_write_json, atomic_write_text
 from ehlfoam.case.dictionaries import edit_physics_dicts, edit_run_control, release_geometry
 from ehlfoam.case.fields import edit_fields, with_supply_patch
 from ehlfoam.case.geometry import META, CaseGeometry
+from ehlfoam.case.ownership import (CaseBeingRun, CaseBusy, CaseExists, check_replaceable,
+                                    hold_run_lock, write_marker)
 from ehlfoam.case.timestep import capillary_time_step, write_interval
 from ehlfoam.foam.runtime import FoamRuntime
 from ehlfoam.gap.source import load_gap
@@ -33,10 +44,10 @@ from ehlfoam.mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extru
 from ehlfoam.spec.case import CaseSpec
 
 TEMPLATES = Path(__file__).resolve().parent / "templates"
+#: In a case being built (a temporary folder beside its place): the builder's pid.
+BUILDER = ".ehlfoam-build"
 
-
-class CaseExists(FileExistsError):
-    """The output folder exists and is not empty."""
+__all__ = ["CaseBeingRun", "CaseExists", "case_mesh", "extrude_level", "write_case"]
 
 
 def extrude_level(spec: CaseSpec, base: BaseMesh, gap) -> PolyMesh:
@@ -83,17 +94,21 @@ def case_mesh(spec: CaseSpec, gap) -> tuple[MeshParams, BaseMesh, PolyMesh, np.n
 
 
 def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | None = None,
-               overwrite: bool = False) -> CaseGeometry:
+               overwrite: bool = False,
+               prepare: Callable[[Path], object] | None = None) -> CaseGeometry:
     """Build the case of ``spec`` in ``out`` (atomically: built in a temporary sibling folder
-    and renamed into place). Returns the case's :class:`CaseGeometry`."""
-    out = Path(out)
+    and renamed into place). ``overwrite``: ``out`` may be an earlier case the tool wrote
+    (not one being run); anything else that is not empty is refused with
+    :class:`CaseExists` before any work. ``prepare`` is called with the complete temporary
+    case folder before it is renamed into place (a start from another state); if it raises,
+    nothing is left and an earlier case stays as it was. Returns the case's
+    :class:`CaseGeometry`."""
+    out = Path(out).absolute()
     if spec.mesh.follow is not None:
         raise ValueError("mesh.follow needs the state the case starts from, whose meniscus "
                          "the mesh follows: ehlfoam case SPEC --out DIR --start-from SOURCE "
                          "(ehlfoam.seed.follow.write_started_case)")
-    if out.exists() and any(out.iterdir()):
-        if not overwrite:
-            raise CaseExists(f"output folder {out} exists and is not empty (use --overwrite)")
+    check_replaceable(out, overwrite)
     runtime = runtime or FoamRuntime.from_environment()
     gap, precalc = load_gap(spec.contact)
     a = spec.a
@@ -121,7 +136,9 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         open_inflow_oil=1.0 if spec.fills_domain else 0.0)
 
     out.parent.mkdir(parents=True, exist_ok=True)
+    _recover(out)
     tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))
+    (tmp / BUILDER).write_text(f"{os.getpid()}\n")
     try:
         shutil.copytree(TEMPLATES / _template_for(spec), tmp, dirs_exist_ok=True)
         write_polymesh(mesh, tmp)
@@ -134,13 +151,60 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         atomic_write_json(meta / "geometry.json", asdict(geom))
         _save_structure(meta / "mesh.npz", mesh)
         shutil.copytree(precalc, tmp / "precalc")
-        if out.exists():
-            shutil.rmtree(out)
-        os.replace(tmp, out)
+        write_marker(tmp)
+        if prepare is not None:
+            prepare(tmp)
+        (tmp / BUILDER).unlink()
+        _swap_into_place(tmp, out, overwrite)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return geom
+
+
+def _alive(pid_file: Path) -> bool:
+    """The process named in ``pid_file`` (a build's) still runs."""
+    try:
+        os.kill(int(pid_file.read_text().split()[0]), 0)
+    except (OSError, ValueError, IndexError):
+        return False
+    return True
+
+
+def _recover(out: Path) -> None:
+    """What a write of ``out`` killed before its end left beside it: an earlier case moved
+    aside (``.NAME.old.*/case``) goes back to ``out`` if ``out`` is missing, else it is
+    removed; a temporary build folder (``.NAME.*``) whose builder died is removed."""
+    for side in sorted(out.parent.glob(f".{out.name}.*")):
+        if not side.is_dir():
+            continue
+        if side.name.startswith(f".{out.name}.old."):
+            if time.time() - side.stat().st_mtime < 60.0:   # maybe another write's, now
+                continue
+            if (side / "case").is_dir() and not out.exists():
+                os.replace(side / "case", out)
+            shutil.rmtree(side, ignore_errors=True)
+        elif (side / BUILDER).is_file() and not _alive(side / BUILDER):
+            shutil.rmtree(side, ignore_errors=True)
+
+
+def _swap_into_place(tmp: Path, out: Path, overwrite: bool) -> None:
+    """Rename the built case ``tmp`` to ``out``. An earlier case there is checked again (it
+    may have changed during the build), moved aside under its run lock (so that no run can
+    start on it meanwhile) and removed only once the new case is in place."""
+    check_replaceable(out, overwrite)
+    if not out.exists() or not any(out.iterdir()):
+        os.replace(tmp, out)      # a new folder, or over an empty one
+        return
+    old = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.old."))
+    try:
+        with hold_run_lock(out):
+            os.replace(out, old / "case")
+            os.replace(tmp, out)
+    except CaseBusy as err:
+        raise CaseBeingRun(f"--out {out} --overwrite: {err}") from None
+    finally:
+        shutil.rmtree(old, ignore_errors=True)
 
 
 def _template_for(spec: CaseSpec) -> str:

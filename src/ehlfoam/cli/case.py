@@ -8,7 +8,6 @@ big; nothing left written).
 from __future__ import annotations
 
 import argparse
-import shutil
 from collections.abc import Iterable
 from typing import Any
 
@@ -125,13 +124,11 @@ def _write(spec, args: argparse.Namespace) -> int:
     try:
         geom, seed = write_started_case(spec, args.out, args.start_from,
                                         overwrite=args.overwrite)
-    except RampError as err:   # found only on the new mesh: leave no half-made case
-        shutil.rmtree(args.out, ignore_errors=True)
+    except RampError as err:   # found only on the new mesh: no case was written
         raise SpecError(f"--start-from {args.start_from}: {err}") from None
     except ValueError as err:   # mesh.follow: the source has no meniscus to follow
         if spec.mesh.follow is None or isinstance(err, SpecError):
             raise               # a mesh too big, ...: bad input all the same (exit 2)
-        shutil.rmtree(args.out, ignore_errors=True)
         raise SpecError(f"--start-from {args.start_from}: {err}") from None
     if seed is not None:
         at = ("" if seed["previous_time_s"] is None

@@ -15,7 +15,7 @@ from ehlfoam.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, add_comma
                                 check_case, positive_float, print_notices)
 
 #: the metrics printed as the command's JSON line
-KEYS = ("status", "end_reason", "state", "inlet_meniscus_distance_over_a",
+KEYS = ("status", "end_reason", "reason", "state", "inlet_meniscus_distance_over_a",
         "inlet_meniscus_shape", "flooded_length_over_a", "flooded_width_over_a",
         "wake_gas_length_over_a", "bubble_length_over_a", "bubble_enclosed",
         "min_pressure_Pa", "oil_mass_balance_error", "simulated_time_s", "time_steps", "wall_s")
@@ -66,7 +66,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     try:
         with progress:
             metrics = run_case(args.case, wall_limit=args.wall_limit, on_sample=on_sample,
-                               extend_transits=args.extend)
+                               extend_transits=args.extend,
+                               on_note=lambda line: print(f"ehlfoam run: {line}",
+                                                          file=sys.stderr, flush=True))
     except (CaseBusy, FileNotFoundError) as err:
         print(f"ehlfoam run: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
