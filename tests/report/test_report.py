@@ -8,7 +8,6 @@ are opened in headless Chromium, which must load every image.
 
 from __future__ import annotations
 
-import argparse
 import csv
 import fcntl
 import json
@@ -28,7 +27,7 @@ from ehlfoam.spec.case import make_case_spec
 from ehlfoam.case.geometry import load_geometry
 from ehlfoam.case.writer import write_case
 from ehlfoam.run.fields import time_folders
-from ehlfoam.cli.report import add_parser
+from ehlfoam.cli.main import main
 from ehlfoam.report import report, report_batch, report_case
 from ehlfoam.report import units
 from ehlfoam.report.charts import bubble_relation_x, fit_bubble_relation
@@ -227,12 +226,8 @@ def test_report_detects_case_and_batch_and_bad_input(finished_case, tmp_path):
     (tmp_path / "empty").mkdir()
     with pytest.raises(ValueError, match="neither a case"):
         report(tmp_path / "empty")
-    parser = argparse.ArgumentParser()
-    add_parser(parser.add_subparsers(dest="command"))
-    args = parser.parse_args(["report", str(tmp_path / "empty")])
-    assert args.func(args) == 2
-    args = parser.parse_args(["report", str(tmp_path / "nowhere")])
-    assert args.func(args) == 2
+    assert main(["report", str(tmp_path / "empty")]) == 2
+    assert main(["report", str(tmp_path / "nowhere")]) == 2
 
 
 @pytest.mark.openfoam
