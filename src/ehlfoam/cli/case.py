@@ -74,10 +74,13 @@ def cmd_case(args: argparse.Namespace) -> int:
     from ehlfoam.errors import SpecError
     from ehlfoam.spec.case import load_case_spec, make_case_spec
 
+    from ehlfoam.case.bounds import check_work
+
     try:
         overrides = parse_overrides(args.set)
         spec = (load_case_spec(args.spec, **overrides) if args.spec
                 else make_case_spec(None, **overrides))
+        check_work(spec)   # mesh.max_cells, run.max_steps: before the precalc and the mesher
     except (SpecError, ValueError) as err:
         return _bad(err)
     if spec.mesh.follow is not None and not args.start_from:
