@@ -4,6 +4,7 @@ example), number types for options, and notices printed one line each."""
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import textwrap
 from collections.abc import Iterable
@@ -30,13 +31,13 @@ def add_command(subparsers, name: str, *, help: str, description: str,
 
 
 def positive_float(text: str) -> float:
-    """argparse type: a number > 0."""
+    """argparse type: a finite number > 0 (NaN and infinity are refused: not limits)."""
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"{value} (valid range > 0)")
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"{text} (valid range > 0, finite)")
     return value
 
 

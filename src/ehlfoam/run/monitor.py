@@ -112,7 +112,8 @@ class LogTail:
 
 def run_case(case: str | Path, runtime: FoamRuntime | None = None,
              wall_limit: float | None = None, on_sample: OnSample | None = None,
-             extend_transits: float | None = None) -> MetricsRecord:
+             extend_transits: float | None = None,
+             oversubscribe: bool = False) -> MetricsRecord:
     """Run the case in ``case`` to steady state (or a limit) and write ``metrics.json``.
 
     Restarts from the latest written time if the case ran before. With ``extend_transits``
@@ -120,12 +121,25 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
     steady-state tests say (to see whether a steady state lasts, or to go on after a time
     limit); it then ends at ``end_time``, the wall limit or divergence. ``wall_limit`` [s]
     defaults to the spec's ``run.wall_limit``. Returns the metrics record (as written).
+
+    Bounds (:mod:`ehlfoam.case.bounds`), checked before anything is written: ``wall_limit``
+    and ``extend_transits`` positive and finite; ``run.n_procs`` within the cores this
+    process may use unless ``oversubscribe``; an extension within ``run.max_steps``. A
+    :class:`~ehlfoam.errors.SpecError` names the one that is not.
     """
-    if extend_transits is not None and not extend_transits > 0:
-        raise ValueError(f"extend_transits = {extend_transits!r} transits: it must be > 0")
+    from ehlfoam.case.bounds import check_extension, check_limit, check_n_procs, check_wall_limit
+
+    if wall_limit is not None:
+        check_wall_limit(wall_limit)
+    if extend_transits is not None:
+        check_limit("extend_transits", extend_transits, "transits")
     path = Path(case).absolute()
     run = _Case(path, load_spec_of(path), load_geometry(path),
                 case_fields.Structure.load(path))
+    check_n_procs(run.spec.run.n_procs, oversubscribe=oversubscribe)
+    if extend_transits is not None:
+        check_extension(run.spec, extend_transits, run.geom.transit_time,
+                        run.geom.max_delta_t)
     lock = open(path / META / "run.lock", "w")
     try:
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
