@@ -111,11 +111,10 @@ def run_task(batch_dir: str, kind: str, key: str, rerun_failed: bool, cpu: int) 
 
 # =========================================================================== executors
 def cpu_budget() -> int:
-    """CPU cores this process may use."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:
-        return os.cpu_count() or 1
+    """CPU cores this process may use (:func:`ehlfoam.case.bounds.usable_cores`)."""
+    from ehlfoam.case.bounds import usable_cores
+
+    return usable_cores()
 
 
 class LocalExecutor:

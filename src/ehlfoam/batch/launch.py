@@ -153,12 +153,12 @@ def check_cores(opts: BatchOptions, plan: list[PlannedCase]) -> None:
                             f"worker (valid range 1 <= run.n_procs <= {opts.slurm['cores']})")
         return
     over = opts.oversubscribe
-    check_n_procs(need, oversubscribe=over, where=f"run.n_procs (case {widest.id})")
+    check_n_procs(need, oversubscribe=over, context=f" (case {widest.id})")
     if opts.cores:
         check_n_procs(opts.cores, oversubscribe=over, where="--cores")
     if opts.jobs:
-        check_n_procs(opts.jobs * need, oversubscribe=over,
-                      where=f"--jobs {opts.jobs} x run.n_procs {need}")
+        check_n_procs(opts.jobs, oversubscribe=over, where="--jobs", per=need,
+                      context=" cases at once")
 
 
 def _make_executor(opts: BatchOptions, plan: list[PlannedCase]):

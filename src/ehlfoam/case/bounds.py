@@ -46,13 +46,15 @@ def usable_cores() -> int:
 
 
 def check_n_procs(n_procs: int, *, oversubscribe: bool = False, cores: int | None = None,
-                  where: str = "run.n_procs") -> None:
-    """Refuse ``n_procs`` ranks (or cores) above the usable cores unless ``oversubscribe``."""
+                  where: str = "run.n_procs", per: int = 1, context: str = "") -> None:
+    """Refuse ``n_procs`` ranks (or cases of ``per`` cores each) above the usable cores
+    unless ``oversubscribe``; the message names ``where`` (and ``context``)."""
     cores = usable_cores() if cores is None else cores
-    if n_procs > cores and not oversubscribe:
-        raise SpecError(f"{where} = {n_procs} is more than the {cores} CPU cores this process "
-                        f"may use (valid range 1 <= {where} <= {cores}; --oversubscribe runs "
-                        f"it anyway, slowly)")
+    if n_procs * per > cores and not oversubscribe:
+        uses = f" x {per} cores (run.n_procs) = {n_procs * per} cores" if per > 1 else ""
+        raise SpecError(f"{where} = {n_procs}{context}{uses} is more than the {cores} CPU "
+                        f"cores this process may use (valid range 1 <= {where} <= "
+                        f"{max(cores // per, 1)}; --oversubscribe runs it anyway, slowly)")
 
 
 def check_limit(name: str, value: object, unit: str = "", upper: float | None = None) -> float:
