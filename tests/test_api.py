@@ -98,3 +98,18 @@ def test_the_readme_shows_the_example_that_runs():
     block = readme.split("```python\n", 1)[1].split("```", 1)[0]
     api = (ROOT / "examples" / "api.py").read_text()
     assert block.strip() and block.strip() in api
+
+
+def test_write_case_and_run_batch_refuse_a_folder_before_any_work(tmp_path):
+    """The API checks where it writes as the command line does (issue 73): a path OpenFOAM
+    cannot take, a file in the way; nothing is written (the batch spec does not even exist:
+    the folder is refused first)."""
+    spec = ehlfoam.make_case_spec(SMALL)
+    (tmp_path / "f").write_text("a file")
+    for out, words in ((tmp_path / "a b", "OpenFOAM cannot take this path: it has a space"),
+                       (tmp_path / "f", "is a file, not a folder")):
+        with pytest.raises(ehlfoam.SpecError, match=words):
+            ehlfoam.write_case(spec, out)
+        with pytest.raises(ehlfoam.SpecError, match=words):
+            ehlfoam.run_batch(tmp_path / "b.toml", out=out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f"]

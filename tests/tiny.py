@@ -51,3 +51,13 @@ def small_contact():
 
     spec = make_case_spec(SMALL)
     return spec, load_gap(spec.contact)[0], spec.a
+
+
+def as_toml(spec: dict) -> str:
+    """A spec dict (scalars and one level of tables, as :data:`SMALL`) as TOML text."""
+    import json
+
+    top = [f"{k} = {json.dumps(v)}" for k, v in spec.items() if not isinstance(v, dict)]
+    tables = [f"[{k}]\n" + "\n".join(f"{kk} = {json.dumps(vv)}" for kk, vv in v.items())
+              for k, v in spec.items() if isinstance(v, dict)]
+    return "\n".join(top + tables) + "\n"

@@ -83,9 +83,13 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, *,
                overwrite: bool = False) -> CaseGeometry:
     """Write the OpenFOAM case of ``spec`` in ``out`` (as ``ehlfoam case``): precalc, mesh,
     OpenFOAM files; started from ``start_from`` (a run case, a case snapshot or a thin-film
-    state) if given. Returns the case's geometry (cells, a, transit time, ...)."""
+    state) if given. Returns the case's geometry (cells, a, transit time, ...). Raises
+    :class:`SpecError` before any work where ``out`` cannot be written (a file, a read-only
+    or full disk) or OpenFOAM cannot take its path (a space, a quote, ...)."""
+    from ehlfoam.paths import check_case_out
     from ehlfoam.seed.follow import write_started_case
 
+    check_case_out(out, "out")
     geometry, _ = write_started_case(spec, out, start_from, overwrite=overwrite)
     return geometry
 
@@ -104,10 +108,14 @@ def run_batch(spec_path: str | os.PathLike, *, out: str | os.PathLike | None = N
     runs/STEM/ in the working folder); ``options`` as ``ehlfoam batch``'s (``jobs``,
     ``cores``, ``rerun_failed``, ``scheduler``, ``quiet``, ...; see
     :class:`ehlfoam.batch.launch.BatchOptions`), and ``report=False`` for no report.
-    Returns the outcome (counts, exit code)."""
+    Returns the outcome (counts, exit code). Raises :class:`SpecError` before any work where
+    the batch folder cannot be written or OpenFOAM cannot take its path."""
+    from ehlfoam.batch.folder import batch_folder
     from ehlfoam.batch.launch import BatchOptions, run_batch as _run_batch
+    from ehlfoam.paths import check_case_out
     from ehlfoam.report import after_batch
 
+    check_case_out(batch_folder(Path(spec_path), None if out is None else Path(out)))
     options["report"] = after_batch if options.get("report", True) else None
     return _run_batch(spec_path, BatchOptions(out=None if out is None else Path(out),
                                               **options))

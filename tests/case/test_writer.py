@@ -148,7 +148,8 @@ def test_case_is_complete_and_runs_by_hand_layout(small_case):
                 "system/fvSolution", "precalc/summary.json", "ehlfoam/spec.json"):
         assert (small_case / rel).is_file(), rel
     allrun = (small_case / "Allrun").read_text()
-    assert "bin/tools/RunFunctions" not in allrun and "@" not in allrun
+    assert "bin/tools/RunFunctions" not in allrun
+    assert not re.search(r"@[A-Z_]+@", allrun)      # every marker filled
     fv = FoamFile(small_case / "system" / "fvSolution")
     assert fv["PIMPLE"]["momentumPredictor"] is False
     geom = load_geometry(small_case)
@@ -1142,9 +1143,11 @@ def test_full_domain_case_builds_and_runs(tmp_path):
 @pytest.mark.openfoam
 def test_monitor_stops_a_steady_run(tmp_path):
     """A meniscus at rest is (nearly) steady: the monitor sees it hold still over one transit
-    and stops the solver through controlDict before the time limit. The tolerance is loose
-    (0.2) because on this coarse test mesh the puddle creeps by ~0.01 a/ms as it relaxes; the
-    test is about the stop mechanism."""
+    and stops the solver through controlDict before the time limit, at the write after the
+    steady one (endTime set to it): two runs of the case end at the same write with the same
+    metrics, whatever the wall clock. The tolerance is loose (0.2) because on this coarse test
+    mesh the puddle creeps by ~0.01 a/ms as it relaxes; the test is about the stop
+    mechanism."""
     spec = make_case_spec({**SMALL, "walls_moving": False,
                            "supply": {"mode": "layers", "disc_layer": 0.0, "ball_layer": 0.0,
                                       "initial_puddle": 3.0},
@@ -1152,10 +1155,18 @@ def test_monitor_stops_a_steady_run(tmp_path):
                                    "writes_per_transit": 5, "steady_tolerance": 0.2}})
     case = tmp_path / "steady"
     write_case(spec, case)
+    twin = _copy(case, tmp_path / "twin")
     m = run_case(case, wall_limit=300)
     assert m["status"] == "finished" and m["end_reason"] == "steady" and m["steady"], m
     assert m["simulated_time_s"] < 0.5 * spec.end_time
-    assert FoamFile(case / "system" / "controlDict")["stopAt"] == "writeNow"
+    control = FoamFile(case / "system" / "controlDict")
+    assert control["stopAt"] == "endTime"
+    last = case_fields.time_folders(case)[-1][0]
+    assert control["endTime"] == pytest.approx(last) == pytest.approx(m["simulated_time_s"])
+    again = run_case(twin, wall_limit=300)
+    clock = {"wall_s", "wall_s_per_simulated_ms"}
+    assert ({k: v for k, v in again.to_json().items() if k not in clock}
+            == {k: v for k, v in m.to_json().items() if k not in clock})
     # --extend: two more transits past the stop, whatever the steady tests say
     t_stop, transit = m["simulated_time_s"], m["transit_time_s"]
     e = run_case(case, wall_limit=300, extend_transits=2.0)

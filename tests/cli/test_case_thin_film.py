@@ -1,6 +1,7 @@
 """`ehlfoam case` on a thin-film spec (issue 74): bad specs refused with exit 2 and one line
 naming the key, its value and what is valid, before anything is written (no OpenFOAM, no
-precalc needed to refuse them)."""
+precalc needed to refuse them), the bounds on the work (mesh.max_cells on the model's grid,
+run.max_steps on its steps) among them."""
 
 from __future__ import annotations
 
@@ -19,6 +20,10 @@ from ehlfoam.cli.main import main
     (["supply.mode=\"submerged\""], 'supply.mode = "submerged" does not apply'),
     (["physics.contact_angle=95"], "physics.contact_angle = 95 deg is out of range"),
     (["thin_film.courant=2"], "thin_film.courant = 2: Input should be less than or equal to 1"),
+    # main's bounds on the work (issue 73) hold for the model's grid and steps too
+    (["mesh.max_cells=1000"], "mesh.max_cells = 1,000: the thin-film grid would have 5,200 "
+                              "cells"),
+    (["run.max_steps=100"], "run.max_steps = 100: reaching the end time"),
 ])
 def test_a_bad_thin_film_spec_is_refused_before_anything_is_written(tmp_path, capsys,
                                                                      monkeypatch, sets, words):

@@ -42,7 +42,7 @@ def test_thin_film_writes_a_state_a_case_starts_from(tmp_path, capsys):
     (["--transits", "-1"], "argument --transits: -1.0 is out of range: must be in (0, 10000]"),
     (["--window", "0"], "argument --window: 0 is out of range: must be in [1, 1000]"),
     (["--set", "contact.speed=-1"], "contact.speed = -1"),
-    (["--set", "contact.speed"], "--set 'contact.speed': must be KEY=VALUE"),
+    (["--set", "contact.speed"], "--set 'contact.speed': expected KEY=VALUE"),
     (["--advancing", "10"], "advancing_angle = 10.0 is out of range: must be None or in [15, 90)"),
     (["--receding", "sticky"], "'sticky': must be 'static', 'bretherton' or a factor"),
     (["--start", "missing.npz"], "--start missing.npz: not a thin-film state"),

@@ -8,8 +8,8 @@ are opened in headless Chromium, which must load every image.
 
 from __future__ import annotations
 
-import argparse
 import csv
+import fcntl
 import json
 import os
 import re
@@ -27,7 +27,7 @@ from ehlfoam.spec.case import make_case_spec
 from ehlfoam.case.geometry import load_geometry
 from ehlfoam.case.writer import write_case
 from ehlfoam.run.fields import time_folders
-from ehlfoam.cli.report import add_parser
+from ehlfoam.cli.main import main
 from ehlfoam.report import report, report_batch, report_case
 from ehlfoam.report import units
 from ehlfoam.report.charts import bubble_relation_x, fit_bubble_relation
@@ -186,9 +186,14 @@ def test_failed_case_says_so_with_the_log_tail(finished_case, tmp_path):
 def test_running_and_never_run_cases(finished_case, tmp_path):
     running = _copy(finished_case, tmp_path / "running")
     (running / "metrics.json").write_text(json.dumps({"status": "running", "cells": 1}))
-    html = report_case(running, animate=False).read_text()
+    with open(running / "ehlfoam" / "run.lock", "a") as lock:   # a live run holds it
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        html = report_case(running, animate=False).read_text()
     assert "Status: running" in html and "still going" in html
     assert "Last lines of the solver log" in html
+    # no process holds the lock: the run was killed and left metrics.json running
+    html = report_case(running, animate=False).read_text()
+    assert "Status: interrupted" in html and "monitor_killed" in html
 
     fresh = _copy(finished_case, tmp_path / "fresh")
     for _, folder in time_folders(fresh):
@@ -221,12 +226,8 @@ def test_report_detects_case_and_batch_and_bad_input(finished_case, tmp_path):
     (tmp_path / "empty").mkdir()
     with pytest.raises(ValueError, match="neither a case"):
         report(tmp_path / "empty")
-    parser = argparse.ArgumentParser()
-    add_parser(parser.add_subparsers(dest="command"))
-    args = parser.parse_args(["report", str(tmp_path / "empty")])
-    assert args.func(args) == 2
-    args = parser.parse_args(["report", str(tmp_path / "nowhere")])
-    assert args.func(args) == 2
+    assert main(["report", str(tmp_path / "empty")]) == 2
+    assert main(["report", str(tmp_path / "nowhere")]) == 2
 
 
 @pytest.mark.openfoam

@@ -91,10 +91,28 @@ def _clean_stale_builds(case: Path) -> None:
             shutil.rmtree(tmp, ignore_errors=True)
 
 
+#: What a build that failed before its case was written leaves in the case's folder.
+_FAILURE_FILES = {"metrics.json", "error.log"}
+
+
+def _clear_failed_build(case: Path) -> None:
+    """Remove the failure record of a build that never wrote its case (metrics.json and
+    error.log alone), so that the folder can take the case; anything else stays (and the
+    case writer refuses a folder that is not its own)."""
+    from ehlfoam.case.ownership import is_own_case
+
+    if not case.is_dir() or is_own_case(case):
+        return
+    entries = list(case.iterdir())
+    if entries and all(p.is_file() and p.name in _FAILURE_FILES for p in entries):
+        for p in entries:
+            p.unlink()
+
+
 def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> dict:
     """Build and run one case of the batch in this process (under its lock) and complete its
     metrics.json. A finished case is left alone; a failed one unless ``rerun_failed``."""
-    from ehlfoam.case.writer import write_case
+    from ehlfoam.case.writer import CaseBeingRun, write_case
     from ehlfoam.gap.source import precalc_dir
     from ehlfoam.run.monitor import CaseBusy, run_case
 
@@ -129,14 +147,23 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
             elif pc.ramp and pc.ramp.get("start_from"):   # the first step: a case or state
                 source = pc.ramp["start_from"]
             stage = "build"   # with mesh.follow, along the source's meniscus
-            write_case(following_spec(pc.spec, source), case, overwrite=True)
-            if source is not None:
+            _clear_failed_build(case)
+            seeded: list[dict] = []
+
+            def start(tmp: Path) -> None:   # in the built case, before it is put in place
+                nonlocal stage
                 stage = "ramp start"
-                seed = seed_case(case, source)
+                seeded.append(seed_case(tmp, source))
+
+            write_case(following_spec(pc.spec, source), case, overwrite=True,
+                       prepare=None if source is None else start)
+            seed = seeded[0] if seeded else None
             build_s = time.monotonic() - t0
             stage = "run"
-            metrics = run_case(case)
-        except CaseBusy as err:
+            # the batch fitted run.n_procs to its cores (--cores, --jobs, --oversubscribe)
+            # or to its Dask workers' CPU resources already
+            metrics = run_case(case, oversubscribe=True)
+        except (CaseBusy, CaseBeingRun) as err:   # an `ehlfoam run` outside the batch
             return {"id": case_id, "kind": "case", "status": "busy", "reason": str(err)}
         except Exception as err:  # noqa: BLE001 - recorded, the batch goes on
             metrics = _record_failure(case, case_id, stage, err, t0)

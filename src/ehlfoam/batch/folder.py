@@ -23,6 +23,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from ehlfoam.case.ownership import lock_held
 from ehlfoam.metrics.record import MetricsRecord, read_metrics
 
 SPEC_COPY, PLAN, RESULTS, CASES, LOCKS = (
@@ -62,17 +63,7 @@ def file_lock(path: Path, timeout: float = 0.0, shared: bool = False) -> Iterato
 
 def lock_is_held(path: Path) -> bool:
     """True if another process holds an flock on ``path`` (probe, released at once)."""
-    try:
-        fh = open(path)
-    except FileNotFoundError:
-        return False
-    try:
-        fcntl.flock(fh, fcntl.LOCK_SH | fcntl.LOCK_NB)
-        return False
-    except BlockingIOError:
-        return True
-    finally:
-        fh.close()
+    return lock_held(path)
 
 
 def metrics_or_none(case: Path) -> MetricsRecord | None:

@@ -55,6 +55,11 @@ def result_row(batch_dir: Path, pc: PlannedCase, live: bool = False,
     status = case_status(case, live)
     ramp = pc.ramp or {}
     reason = m.get("reason", "") if status in ("failed", "interrupted") else ""
+    end_reason = m.get("end_reason") if status != "pending" else None
+    if status == "interrupted" and m.status == "running":   # its lock is free: killed
+        end_reason = "monitor_killed"
+        reason = ("the process running it was killed before the run ended (metrics.json "
+                  "said running, its run lock was free); rebuilt on the next run")
     if status == "interrupted" and not reason:
         reason = "stopped before the end of its run (rebuilt on the next run)"
     if status == "pending" and blocked:
@@ -62,7 +67,7 @@ def result_row(batch_dir: Path, pc: PlannedCase, live: bool = False,
     log = solver_log(case)
     row = {"case_id": pc.id, **pc.params, "ramp": ramp.get("name"),
            "ramp_step": ramp.get("step"), "ramp_direction": ramp.get("direction"),
-           "status": status, "end_reason": m.get("end_reason") if status != "pending" else None,
+           "status": status, "end_reason": end_reason,
            "reason": reason, "state": m.get("state") if status == "finished" else None,
            "wall_s": m.get("wall_s"), "cells": m.get("cells"),
            "case_dir": f"{CASES}/{pc.id}",

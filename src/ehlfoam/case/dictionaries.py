@@ -31,9 +31,17 @@ def edit_physics_dicts(spec: CaseSpec, case: Path) -> None:
             f["solvers"]['"alpha.oil.*"']["nAlphaSubCycles"] = spec.run.alpha_subcycles
     if spec.physics.interface_schemes == "balanced":
         _balance_interface_schemes(case)
+    write_decomposition(case, spec.run.n_procs)
+
+
+def write_decomposition(case: Path, n_procs: int) -> None:
+    """system/decomposeParDict for ``n_procs`` ranks: slabs along x (method simple,
+    ``n (n_procs 1 1)``). Written by the case writer and again by ``ehlfoam run`` before it
+    decomposes, from the spec's run.n_procs (one source of truth)."""
     with FoamFile(case / "system" / "decomposeParDict") as f:
-        f["numberOfSubdomains"] = spec.run.n_procs
-        f["coeffs"]["n"] = [spec.run.n_procs, 1, 1]
+        f["numberOfSubdomains"] = n_procs
+        f["method"] = "simple"
+        f["coeffs"]["n"] = [n_procs, 1, 1]
 
 
 def edit_run_control(spec: CaseSpec, case: Path, end_time: float, write_interval: float,

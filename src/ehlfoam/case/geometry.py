@@ -9,6 +9,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from ehlfoam.errors import SpecError
 from ehlfoam.notices import Notice
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.sections import DomainBox
@@ -102,11 +103,34 @@ def mesh_warnings(geom: CaseGeometry) -> list[Notice]:
                    "docs/models/interface.md#ball-wall-steps")]
 
 
+class CaseFileError(SpecError):
+    """A record of a written case (``ehlfoam/spec.json``, ``ehlfoam/geometry.json``) that
+    cannot be read: corrupt, or not written by ehlfoam."""
+
+
+def _read_record(case: str | os.PathLike, name: str, parse):
+    """``parse(text)`` of ``case/ehlfoam/NAME``; :class:`CaseFileError` naming the file and
+    why if it is not what ehlfoam wrote (FileNotFoundError if it is missing)."""
+    data = (Path(case) / META / name).read_bytes()
+    try:
+        return parse(data.decode("utf-8"))
+    except (ValueError, TypeError) as err:   # JSON, pydantic, UTF-8 errors are ValueErrors
+        if hasattr(err, "errors"):            # pydantic: its first problems, one line
+            why = "; ".join(f"{'.'.join(map(str, e['loc']))}: {e['msg']}" if e["loc"]
+                            else e["msg"] for e in err.errors()[:3])
+        else:
+            why = str(err).splitlines()[0] if str(err) else type(err).__name__
+        raise CaseFileError(f"case {case}: {META}/{name} is corrupt ({why}); write the case "
+                            f"again (ehlfoam case SPEC --out {case} --overwrite)") from None
+
+
 def load_geometry(case: str | os.PathLike) -> CaseGeometry:
-    """The :class:`CaseGeometry` a generated case was written with."""
-    return CaseGeometry(**json.loads((Path(case) / META / "geometry.json").read_text()))
+    """The :class:`CaseGeometry` a generated case was written with (:class:`CaseFileError`
+    if its record is corrupt)."""
+    return _read_record(case, "geometry.json", lambda text: CaseGeometry(**json.loads(text)))
 
 
 def load_spec_of(case: str | os.PathLike) -> CaseSpec:
-    """The spec a generated case was written from."""
-    return CaseSpec.model_validate_json((Path(case) / META / "spec.json").read_text())
+    """The spec a generated case was written from (:class:`CaseFileError` if its record is
+    corrupt)."""
+    return _read_record(case, "spec.json", CaseSpec.model_validate_json)

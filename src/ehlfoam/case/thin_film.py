@@ -9,7 +9,9 @@ whose solver is "thin-film", its cells the grid's), ``ehlfoam/thin_film.json`` (
 the model's options: the marker of a thin-film case), ``precalc/`` (the EHL precalc the gap
 comes from) and, when it starts from a state, ``ehlfoam/start.npz``. ``ehlfoam run DIR``
 marches it (:mod:`ehlfoam.run.thin_film`) and writes ``metrics.json``, ``history.csv``,
-``state.npz`` and ``log.thin-film``.
+``state.npz`` and ``log.thin-film``. Like a 3D case it is built in a temporary folder, marked
+the tool's own (``ehlfoam/case.json``) and put in place by
+:func:`ehlfoam.case.writer.write_case`.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import tempfile
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -32,7 +34,7 @@ from ehlfoam.spec.thin_film import thin_film_cells
 from ehlfoam.thinfilm.from_spec import problem_from_spec, scene_options
 from ehlfoam.thinfilm.problem import Grid
 
-__all__ = ["MARKER", "START", "is_thin_film_case", "read_marker", "write_thin_film_case"]
+__all__ = ["MARKER", "START", "is_thin_film_case", "read_marker", "thin_film_case"]
 
 #: in ``ehlfoam/``: the grid and the options of a thin-film case (its marker), and the state
 #: it starts from
@@ -50,11 +52,11 @@ def read_marker(case: str | os.PathLike) -> dict[str, Any]:
     return json.loads((Path(case) / META / MARKER).read_text())
 
 
-def write_thin_film_case(spec: CaseSpec, out: str | os.PathLike) -> CaseGeometry:
-    """Write the thin-film case of ``spec`` in ``out`` (built in a temporary sibling folder
-    and renamed into place, replacing what is there: the caller has checked that it may).
-    Returns its :class:`CaseGeometry`."""
-    out = Path(out)
+def thin_film_case(spec: CaseSpec) -> tuple[CaseGeometry, Callable[[Path], None]]:
+    """The thin-film case of ``spec``: its :class:`CaseGeometry` and the function that writes
+    its files into a (temporary, empty) case folder. The EHL precalc is solved or reused
+    here; :func:`ehlfoam.case.writer.write_case` builds the folder, marks it the tool's own
+    and puts it in place."""
     gap, precalc = load_gap(spec.contact)
     options = scene_options(spec)
     prob = problem_from_spec(spec, gap, options)
@@ -79,19 +81,13 @@ def write_thin_film_case(spec: CaseSpec, out: str | os.PathLike) -> CaseGeometry
               "grid_cells": thin_film_cells(spec), "cells": cells,
               "domain_over_a": list(options.domain), "options": asdict(options),
               "cavitation_pressure_gauge_Pa": prob.cavitation_pressure, "time_step_s": dt}
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}."))
-    try:
-        meta = tmp / META
+
+    def fill(folder: Path) -> None:
+        meta = folder / META
         meta.mkdir()
         atomic_write_text(meta / "spec.json", spec.model_dump_json(indent=2) + "\n")
         atomic_write_json(meta / "geometry.json", asdict(geom))
         atomic_write_json(meta / MARKER, marker)
-        shutil.copytree(precalc, tmp / "precalc")
-        if out.exists():
-            shutil.rmtree(out)
-        os.replace(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return geom
+        shutil.copytree(precalc, folder / "precalc")
+
+    return geom, fill

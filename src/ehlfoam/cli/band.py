@@ -11,7 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, add_command
+from ehlfoam.cli.common import EXIT_FAILURE, EXIT_OK, add_command, check_case
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -42,30 +42,27 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def check_args(args: argparse.Namespace) -> None:
-    """Bad numbers fail before the case is read, naming the option and its range."""
+    """Bad numbers (NaN and inf too) fail before the case is read, naming the option and its
+    range: :class:`~ehlfoam.errors.SpecError`."""
+    from ehlfoam.errors import SpecError
+
     for name, value, hi in (("--size", args.size, 10.0), ("--half-width", args.half_width, 20.0),
                             ("--spacing", args.spacing, 20.0)):
         if value is not None and not 0.0 < value <= hi:
-            raise ValueError(f"{name} = {value:g} a is out of range (0 < {name} <= {hi:g} a)")
+            raise SpecError(f"{name} = {value:g} a is out of range (0 < {name} <= {hi:g} a)")
     if args.min_length is not None and not 0.0 <= args.min_length <= 1e3:
-        raise ValueError(f"--min-length = {args.min_length:g} a is out of range "
-                         "(0 <= --min-length <= 1000 a)")
+        raise SpecError(f"--min-length = {args.min_length:g} a is out of range "
+                        "(0 <= --min-length <= 1000 a)")
 
 
 def cmd_band(args: argparse.Namespace) -> int:
-    """Print the bands along the case's meniscus (TOML on stdout, a summary on stderr)."""
-    try:
-        check_args(args)
-    except ValueError as err:
-        print(f"ehlfoam band: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    """Print the bands along the case's meniscus (TOML on stdout, a summary on stderr). Bad
+    input raises (exit 2, :mod:`ehlfoam.cli.failures`)."""
+    check_args(args)
+    check_case(args.case, "CASE")
     from ehlfoam.seed.band import bands_toml, meniscus_bands, meniscus_lines
 
-    try:
-        time, lines = meniscus_lines(args.case, args.time)
-    except (ValueError, FileNotFoundError) as err:
-        print(f"ehlfoam band: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    time, lines = meniscus_lines(args.case, args.time)
     bands = meniscus_bands(lines, args.size, args.half_width, args.spacing, args.min_length)
     if not bands:
         shortest = args.half_width if args.min_length is None else args.min_length

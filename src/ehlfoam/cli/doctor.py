@@ -1,6 +1,7 @@
 """``ehlfoam doctor``: show the configured OpenFOAM runtime and check its build (pitzDaily).
 
-Exit codes: 0 the build is sound, 1 it is broken, 2 the configuration is invalid.
+Exit codes: 0 the build is sound, 1 it is broken, 2 the configuration is invalid or
+--workdir cannot be written.
 """
 
 from __future__ import annotations
@@ -28,6 +29,10 @@ def cmd_doctor(args: argparse.Namespace) -> int:
     """Print the configured OpenFOAM runtime and run the pitzDaily build check."""
     from ehlfoam.foam.runtime import FoamRuntime, check_build
 
+    if args.workdir is not None:
+        from ehlfoam.paths import check_case_out
+
+        check_case_out(args.workdir, "--workdir")
     runtime = FoamRuntime.from_environment()
     print("OpenFOAM runtime")
     for key, value in runtime.describe().items():

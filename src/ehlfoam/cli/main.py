@@ -12,9 +12,13 @@ Subcommands, one module each in :mod:`ehlfoam.cli`:
   batch    generate, run and report a batch of cases (sweeps, speed ramps)
   foam     any OpenFOAM application through the configured runtime
 
-Exit codes: 0 ok, 1 failure, 2 bad input, 130 interrupted (``ehlfoam foam``: the
-application's own). The subcommand modules import only the standard library at the top, so
-that ``--help`` is quick; numpy, scipy, pyvista, foamlib, gmsh and dask load in the commands.
+Exit codes: one table, :data:`ehlfoam.cli.common.EXIT_CODES` (0 ok, 1 failed, 2 bad input,
+3 not converged, 70 internal error, 130 interrupted; ``ehlfoam foam``: the application's
+own), shown by ``ehlfoam --help`` and docs/cli.md. Whatever a command raises goes through one
+error path, :mod:`ehlfoam.cli.failures`: one line ``ehlfoam COMMAND: MESSAGE`` and its exit
+code, or the traceback with ``ehlfoam --debug COMMAND ...``. The subcommand modules import
+only the standard library at the top, so that ``--help`` is quick; numpy, scipy, pyvista,
+foamlib, gmsh and dask load in the commands.
 """
 
 from __future__ import annotations
@@ -26,7 +30,8 @@ from collections.abc import Sequence
 
 from ehlfoam.cli import (band, batch, case, doctor, foam, precalc, report, run, snapshot,
                          thin_film)
-from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_INTERRUPTED
+from ehlfoam.cli.common import EXIT_BAD_INPUT, exit_code_table
+from ehlfoam.cli.failures import run_command
 
 #: the subcommands, in the order ``ehlfoam --help`` lists them
 COMMANDS = (doctor, precalc, thin_film, case, run, band, snapshot, report, batch, foam)
@@ -49,6 +54,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="OpenFOAM cases of the oil flow around an EHL ball-on-disc contact.",
         epilog="OpenFOAM is chosen with EHLFOAM_FOAM=embedded|native|prefix,\n"
                "EHLFOAM_FOAM_PREFIX and EHLFOAM_CACHE (docs/runtime.md; `ehlfoam doctor` checks it).\n\n"
+               "exit codes (docs/cli.md; `ehlfoam foam` exits with its application's code):\n"
+               + exit_code_table() + "\n\n"
                "example:\n"
                "  ehlfoam case examples/cases/nominal.toml --out runs/nominal "
                "--set mesh.resolution=coarse\n"
@@ -56,6 +63,9 @@ def build_parser() -> argparse.ArgumentParser:
                "  ehlfoam COMMAND --help",
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"ehlfoam {version()}")
+    parser.add_argument("--debug", action="store_true",
+                        help="on an error, show its traceback (for a bug report) instead of "
+                             "one line")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for module in COMMANDS:
         module.add_parser(sub)
@@ -74,18 +84,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse: --help, --version (0) or bad usage (2)
         return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
-    from ehlfoam.foam.runtime import FoamConfigError, FoamError
-
-    try:
-        return int(args.func(args))
-    except FoamConfigError as exc:
-        print(f"ehlfoam: configuration error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except FoamError as exc:
-        print(f"ehlfoam {args.command}: {exc}", file=sys.stderr)
-        return EXIT_FAILURE
-    except KeyboardInterrupt:
-        return EXIT_INTERRUPTED
+    [action] = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    return run_command(args, args.command, action.choices[args.command], debug=args.debug)
 
 
 if __name__ == "__main__":

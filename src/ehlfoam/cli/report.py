@@ -1,7 +1,8 @@
 """``ehlfoam report DIR``: the HTML report of a case or a batch (:mod:`ehlfoam.report`).
 
 Exit codes: 0 the report was written (also for a failed or running case: the page says so),
-1 the report could not be written, 2 bad input (DIR missing, or neither a case nor a batch).
+1 the report could not be written, 2 bad input (DIR missing, neither a case nor a batch, a
+corrupt case record, DIR read-only or its disk full).
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ import argparse
 import sys
 import time
 
-from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, add_command, positive_int
+from ehlfoam.cli.common import EXIT_FAILURE, EXIT_OK, add_command, check_case, positive_int
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -35,9 +36,21 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    """Write the report of a case or a batch folder and print where it is."""
+    """Check DIR, write the report of a case or a batch folder and print where it is."""
+    from pathlib import Path
+
+    from ehlfoam.case.geometry import META
+    from ehlfoam.errors import SpecError
+    from ehlfoam.paths import check_output
     from ehlfoam.report import report
 
+    folder = Path(args.dir)
+    if not folder.is_dir():
+        raise SpecError(f"DIR {args.dir}: " + ("is a file, not a case or batch folder"
+                                               if folder.exists() else "no such folder"))
+    if (folder / META).is_dir():
+        check_case(folder, "DIR")
+    check_output(folder, "DIR")
     start = time.perf_counter()
     kwargs = {"animate": not args.no_gif}
     if args.jobs is not None:
@@ -46,9 +59,8 @@ def cmd_report(args: argparse.Namespace) -> int:
         kwargs["force"] = True
     try:
         index = report(args.dir, **kwargs)
-    except (FileNotFoundError, ValueError) as exc:
-        print(f"ehlfoam report: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    except (OSError, ValueError):
+        raise                  # bad input, a full disk: the one error path (exit 2)
     except Exception as exc:  # noqa: BLE001 - the command reports, the page could not be made
         print(f"ehlfoam report: could not write the report of {args.dir}: "
               f"{type(exc).__name__}: {exc}", file=sys.stderr)

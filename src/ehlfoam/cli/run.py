@@ -1,7 +1,10 @@
 """``ehlfoam run``: run a case to steady state and write its metrics.json.
 
 Exit codes: 0 finished, 1 failed or stopped short (metrics.json says why), 2 bad input (no
-such case, or a case another process is running).
+such case, not a case, a corrupt case file, a path OpenFOAM cannot take, a read-only or full
+disk, a case another process is running, a limit that is not a positive finite number,
+run.n_procs above the usable cores without --oversubscribe, an extension beyond
+run.max_steps; found before anything is written).
 """
 
 from __future__ import annotations
@@ -11,10 +14,10 @@ import json
 import sys
 
 from ehlfoam.cli.common import (EXIT_BAD_INPUT, EXIT_FAILURE, EXIT_OK, add_command,
-                                positive_float, print_notices)
+                                check_case, positive_float, print_notices)
 
 #: the metrics printed as the command's JSON line
-KEYS = ("status", "end_reason", "state", "inlet_meniscus_distance_over_a",
+KEYS = ("status", "end_reason", "reason", "state", "inlet_meniscus_distance_over_a",
         "inlet_meniscus_shape", "flooded_length_over_a", "flooded_width_over_a",
         "wake_gas_length_over_a", "bubble_length_over_a", "bubble_enclosed",
         "min_pressure_Pa", "oil_mass_balance_error", "simulated_time_s", "time_steps", "wall_s")
@@ -35,13 +38,21 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="go on for TRANSITS transit times past the latest written time (from 0 "
                         "in a case not run yet), whatever the steady-state tests say (does "
                         "a steady state last?)")
+    p.add_argument("--oversubscribe", action="store_true",
+                   help="run even when run.n_procs is more than the CPU cores this process "
+                        "may use (refused otherwise)")
     p.add_argument("--quiet", action="store_true", help="no line per written time")
     p.set_defaults(func=cmd_run)
     return p
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """Run a generated case, print its main metrics as one JSON line and its notices."""
+    """Check the case, run it, print its main metrics as one JSON line and its notices."""
+    from ehlfoam.case.thin_film import is_thin_film_case
+
+    check_case(args.case, "CASE", writes=True)
+    if not is_thin_film_case(args.case):   # the thin-film scene has no OpenFOAM files
+        check_control_dict(args.case)
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from ehlfoam.notices import from_text
@@ -60,16 +71,49 @@ def cmd_run(args: argparse.Namespace) -> int:
         if not args.quiet:
             progress.console.print(sample_line(sample, geom), highlight=False, soft_wrap=True)
 
+    from ehlfoam.case.bounds import check_limit, check_wall_limit
+    from ehlfoam.errors import SpecError
+
     try:
+        if args.wall_limit is not None:   # the options by their names, before anything starts
+            check_wall_limit(args.wall_limit, "--wall-limit")
+        if args.extend is not None:
+            check_limit("--extend", args.extend, "transits")
         with progress:
             metrics = run_case(args.case, wall_limit=args.wall_limit, on_sample=on_sample,
-                               extend_transits=args.extend)
-    except (CaseBusy, FileNotFoundError) as err:
+                               extend_transits=args.extend,
+                               on_note=lambda line: print(f"ehlfoam run: {line}",
+                                                          file=sys.stderr, flush=True),
+                               oversubscribe=args.oversubscribe)
+    except (CaseBusy, FileNotFoundError, SpecError) as err:
         print(f"ehlfoam run: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     print(json.dumps({k: metrics.get(k) for k in KEYS}))
     print_notices("run", from_text(metrics.get("warnings")))
     return EXIT_OK if metrics["status"] == "finished" else EXIT_FAILURE
+
+
+def check_control_dict(case) -> None:
+    """The case's ``system/controlDict``, which the run edits (stopAt, endTime), must read as
+    an OpenFOAM dictionary: :class:`~ehlfoam.errors.SpecError` naming it, before anything is
+    written."""
+    from pathlib import Path
+
+    from foamlib import FoamFile
+
+    from ehlfoam.cli.failures import foam_parse_text
+    from ehlfoam.errors import SpecError
+
+    path = Path(case) / "system" / "controlDict"
+    if not path.is_file():
+        raise SpecError(f"CASE {case}: it has no system/controlDict (not a complete case; "
+                        f"write it again with ehlfoam case SPEC --out {case} --overwrite)")
+    try:
+        FoamFile(path).as_dict()
+    except ValueError as err:   # foamlib's FoamFileDecodeError, a UnicodeDecodeError
+        raise SpecError(f"CASE {case}: system/controlDict is not a valid OpenFOAM dictionary "
+                        f"({foam_parse_text(err)}); write the case again with ehlfoam case SPEC --out {case} "
+                        f"--overwrite") from None
 
 
 def sample_line(sample, geom) -> str:

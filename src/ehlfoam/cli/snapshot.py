@@ -8,10 +8,9 @@ unknown fields).
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
-from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_OK, add_command
+from ehlfoam.cli.common import EXIT_OK, add_command, check_case
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -37,15 +36,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def cmd_snapshot(args: argparse.Namespace) -> int:
-    """Write the snapshot and print what it holds."""
-    from ehlfoam.seed.snapshot import SnapshotError, save_snapshot
+    """Check the case and where to write, write the snapshot and print what it holds. Bad
+    input raises (exit 2, :mod:`ehlfoam.cli.failures`): nothing is written."""
+    from ehlfoam.paths import check_output
+    from ehlfoam.seed.snapshot import save_snapshot
 
+    check_case(args.case, "CASE")
+    check_output(args.out, "OUT", folder=False)
     fields = {"fields": tuple(args.fields)} if args.fields else {}
-    try:
-        record = save_snapshot(args.case, args.out, args.time, **fields)
-    except (SnapshotError, ValueError, OSError) as err:
-        print(f"ehlfoam snapshot: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    record = save_snapshot(args.case, args.out, args.time, **fields)
     size = args.out.stat().st_size
     print(f"snapshot {args.out}: {record['source']} at t = {record['time_s']:.6g} s "
           f"({record['transits']:.4f} transits), {record['cells']} cells, "

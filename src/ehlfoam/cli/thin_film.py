@@ -10,6 +10,7 @@ solved or written.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from dataclasses import asdict
@@ -41,15 +42,29 @@ def _ranged(kind: type, lo: float, hi: float | None = None, lo_open: bool = True
     return parse
 
 
+def _finite(text: str) -> float:
+    """An argparse type: a finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value
+
+
 def _receding(text: str) -> str | float:
     """--receding: 'static', 'bretherton' or a factor (the model checks its range)."""
     if text in ("static", "bretherton"):
         return text
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
         raise argparse.ArgumentTypeError(
-            f"{text!r}: must be 'static', 'bretherton' or a factor in [0.5, 2]") from None
+            f"{text!r}: must be 'static', 'bretherton' or a factor in [0.5, 2]")
+    return value
 
 
 def add_parser(subparsers: Any) -> None:
@@ -67,7 +82,8 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument("--out", required=True, type=Path, metavar="DIR",
                    help="folder to write state.npz and summary.json into")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a spec value, as `ehlfoam case --set` (repeatable)")
+                   help="override a spec value, as `ehlfoam case --set` (TOML values, strict "
+                        "types; an {inline table} merges into the spec's table; repeatable)")
     p.add_argument("--transits", type=_ranged(float, 0.0, 1e4), default=None,
                    help="transits to march (default: 10); with --balance, the most to march "
                         "(default: 200)")
@@ -78,9 +94,9 @@ def add_parser(subparsers: Any) -> None:
                         "changed by less than it over --window transits (default: 0.01)")
     p.add_argument("--window", type=_ranged(int, 1, 1000, lo_open=False), default=5,
                    help="of --balance, transits (default: 5)")
-    p.add_argument("--cell", type=float, default=0.2, metavar="SIZE",
+    p.add_argument("--cell", type=_ranged(float, 0.0, 10.0), default=0.2, metavar="SIZE",
                    help="cell size, units of a (default: 0.2)")
-    p.add_argument("--domain", nargs=3, type=float, default=[-11.0, 19.0, 11.0],
+    p.add_argument("--domain", nargs=3, type=_finite, default=[-11.0, 19.0, 11.0],
                    metavar=("X_MIN", "X_MAX", "Y_MAX"),
                    help="the half domain, units of a (default: -11 19 11)")
     p.add_argument("--courant", type=_ranged(float, 0.0, 1.0), default=0.25,
@@ -88,7 +104,8 @@ def add_parser(subparsers: Any) -> None:
     p.add_argument("--receding", type=_receding, default="static",
                    help="the receding meniscus's pressure: static, bretherton or a factor "
                         "in [0.5, 2] on the static one (default: static)")
-    p.add_argument("--advancing", type=float, default=None, metavar="DEG",
+    p.add_argument("--advancing", type=_ranged(float, 0.0, 180.0, lo_open=False), default=None,
+                   metavar="DEG",
                    help="apparent angle of menisci advancing onto dry walls, from the "
                         "spec's contact angle to 90 deg (default: the contact angle)")
     p.add_argument("--start", type=Path, default=None, metavar="STATE.npz",
@@ -100,36 +117,30 @@ def add_parser(subparsers: Any) -> None:
 
 def cmd_thin_film(args: argparse.Namespace) -> int:
     """Validate, march, write the state and its summary, print the region's metrics."""
+    from ehlfoam.cli.case import parse_overrides   # the one reading of --set
+    from ehlfoam.cli.common import removed_on_failure
     from ehlfoam.errors import SpecError
     from ehlfoam.gap.source import load_gap
+    from ehlfoam.paths import check_output
     from ehlfoam.spec.case import load_case_spec, make_case_spec
     from ehlfoam.thinfilm.from_spec import (STATE_FILE, SUMMARY_FILE, RegionOptions, march,
                                             problem_from_spec, write_region)
     from ehlfoam.thinfilm.state import load_state
 
-    def bad(message: str) -> int:
-        print(f"ehlfoam thin-film: {message}", file=sys.stderr)
-        return 2
-
-    try:
-        overrides = _overrides(args.set)
-        spec = (load_case_spec(args.spec, **overrides) if args.spec
-                else make_case_spec(None, **overrides))
-    except (SpecError, ValueError) as err:
-        return bad(str(err))
+    overrides = parse_overrides(args.set)
+    spec = (load_case_spec(args.spec, **overrides) if args.spec
+            else make_case_spec(None, **overrides))
+    check_output(args.out, "--out")        # before anything is solved
     start = None
     if args.start is not None:
         try:
             start = load_state(args.start)
         except (OSError, KeyError, ValueError) as err:
-            return bad(f"--start {args.start}: not a thin-film state ({err})")
+            raise SpecError(f"--start {args.start}: not a thin-film state ({err})") from None
     options = RegionOptions(cell=args.cell, domain=tuple(args.domain), receding=args.receding,
                             advancing_angle=args.advancing)
     gap, _ = load_gap(spec.contact)
-    try:
-        prob = problem_from_spec(spec, gap, options)
-    except ValueError as err:
-        return bad(str(err))
+    prob = problem_from_spec(spec, gap, options)   # a ValueError: bad input (exit 2)
     transits = args.transits or (200.0 if args.balance else 10.0)
     t0 = time.perf_counter()
     sol = march(spec, prob, transits=transits, balance=args.balance,
@@ -141,24 +152,11 @@ def cmd_thin_film(args: argparse.Namespace) -> int:
               "window": args.window if args.balance else None, "courant": args.courant,
               "start": None if args.start is None else str(args.start),
               "wall_s": time.perf_counter() - t0}
-    summary = write_region(sol, spec, args.out, record)
+    with removed_on_failure(args.out):
+        summary = write_region(sol, spec, args.out, record)
     print(_metrics_text(summary), flush=True)
     print(f"wrote {args.out / STATE_FILE} and {args.out / SUMMARY_FILE}")
     return 0
-
-
-def _overrides(items: list[str]) -> dict[str, Any]:
-    """``--set KEY=VALUE`` items as spec overrides, each value read as ``ehlfoam case`` reads
-    it."""
-    from ehlfoam.cli.case import parse_value   # the one reading of a --set value
-
-    out = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        if not sep or not key:
-            raise ValueError(f"--set {item!r}: must be KEY=VALUE")
-        out[key] = parse_value(value)
-    return out
 
 
 def _progress(spec: Any):

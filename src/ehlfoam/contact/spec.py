@@ -26,7 +26,9 @@ class PrecalcSpec(BaseModel):
     """Operating conditions and numerical settings of one EHL precalc (SI units; each field
     states its unit in ``json_schema_extra["unit"]``)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    #: unknown keys refused, frozen, NaN and inf refused, strict types (no true or "25" for
+    #: a number, no 2.0 for an integer; an integer is a number)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
     load: float = Field(20.0, gt=0.0, le=1e5,
                         description="Normal load F pressing the ball on the disc.",

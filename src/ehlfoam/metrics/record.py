@@ -72,8 +72,13 @@ class MetricsRecord(BaseModel):
         "Run status: running, finished (steady or at a limit), failed or interrupted",
         "Run status")
     end_reason: str | None = _text(
-        "Why the run ended: steady, end_time, wall_limit, diverged, interrupted; a batch adds "
-        "build_error, ramp_start_error, run_error, worker_lost", "End reason")
+        "Why the run ended: steady, end_time, wall_limit, diverged (the solver failed after "
+        "its first time step), start_failed (before it: decomposition, a path OpenFOAM "
+        "refuses, a solver that cannot start; reason has the log's words), case_removed (the "
+        "case folder was removed mid-run), monitor_error, interrupted (Ctrl-C, SIGTERM), "
+        "monitor_killed (status interrupted: metrics.json was left running by a killed run, "
+        "its run lock free); a batch adds build_error, ramp_start_error, run_error, "
+        "worker_lost", "End reason")
     steady: bool | None = _text("A steady-state test stopped the run", "Steady state reached")
     solver_exit_code: int | None = _text("The solver's exit code", "Solver exit code")
     simulated_time_s: float | None = _key("Simulated time at the last write", "s",
@@ -248,7 +253,8 @@ class MetricsRecord(BaseModel):
         "The steady-state test that stopped the run", "Steady-state test that stopped the run")
     # ---------------------------------------------------------------- added by a batch
     case_id: str | None = _text("The case's id in its batch", "Case id")
-    reason: str | None = _text("Why a batch case failed (one line)", "Failure reason")
+    reason: str | None = _text("Why the run or the batch case failed or stopped (one line)",
+                               "Failure reason")
     build_wall_s: float | None = _key("Wall-clock time of building the case (a batch)", "s",
                                       "Build wall time")
     case_wall_s: float | None = _key("Wall-clock time of building and running the case",

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
@@ -27,6 +28,7 @@ from pathlib import Path
 
 from ehlfoam._io import atomic_write_json
 from ehlfoam.batch.regime import REGIME
+from ehlfoam.foam.lifetime import set_parent_death_signal
 from ehlfoam.report import units
 from ehlfoam.report.batch_rows import read_results
 from ehlfoam.report.batch_tables import (convergence_table, failures_table, fmt, index_table,
@@ -75,6 +77,13 @@ def _case_worker(folder: str, animate: bool) -> tuple[str, str | None]:
         return folder, f"{type(exc).__name__}: {exc}"
 
 
+def _die_with_batch(parent: int) -> None:
+    """Initializer of a report worker: it dies with the process that made the pool (a batch
+    killed while its report is drawn leaves no worker behind; the pool's resource tracker
+    then ends too, its last user gone)."""
+    set_parent_death_signal(signal.SIGKILL, parent)
+
+
 def make_case_reports(folders: list[Path], jobs: int, animate: bool) -> dict[Path, str]:
     """Case reports of ``folders``, ``jobs`` at a time (separate processes); returns the
     folders whose report failed, with the error."""
@@ -88,7 +97,8 @@ def make_case_reports(folders: list[Path], jobs: int, animate: bool) -> dict[Pat
                 errors[f] = err
         return errors
     with ProcessPoolExecutor(max_workers=min(jobs, len(folders)),
-                             mp_context=get_context("spawn")) as pool:
+                             mp_context=get_context("spawn"), initializer=_die_with_batch,
+                             initargs=(os.getpid(),)) as pool:
         for folder, err in pool.map(_case_worker, [str(f) for f in folders],
                                     [animate] * len(folders)):
             if err:

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ehlfoam.case.geometry import META, CaseGeometry
+from ehlfoam.case.ownership import run_lock_held
 from ehlfoam.metrics.record import read_metrics
 from ehlfoam.run.history import history_columns, read_history
 
@@ -174,8 +175,10 @@ def find_log(case: Path, geom: CaseGeometry | None) -> Path | None:
     return logs[-1] if logs else None
 
 
-def _status(metrics: dict | None, log: Path | None) -> tuple[str, str]:
-    """(status, a sentence about it)."""
+def _status(metrics: dict | None, log: Path | None, case: Path | None = None
+            ) -> tuple[str, str]:
+    """(status, a sentence about it). A metrics.json that says running while no process
+    holds the case's run lock was left by a run that was killed: interrupted."""
     age = time.time() - log.stat().st_mtime if log and log.exists() else None
     if metrics is None:
         if log is None:
@@ -191,6 +194,10 @@ def _status(metrics: dict | None, log: Path | None) -> tuple[str, str]:
         steady = "steady state reached" if metrics.get("steady") else \
             f"not steady (ended at {reason})"
         return status, f"The run finished: {steady}."
+    if status == "running" and case is not None and not run_lock_held(case):
+        return "interrupted", ("The run was killed before it ended (monitor_killed: "
+                               "metrics.json says running, but no process holds its run "
+                               "lock); this report shows its last write.")
     if status == "running":
         live = (f"the solver log was written {age:.0f} s ago" if age is not None
                 else "no solver log yet")
@@ -217,7 +224,7 @@ def load_case(case: str | os.PathLike) -> CaseInfo:
     spec, spec_dict = _load_spec(case, problems)
     metrics = _read_metrics(case, problems)
     log = find_log(case, geom)
-    status, detail = _status(metrics, log)
+    status, detail = _status(metrics, log, case)
     try:
         history = read_history(case / "history.csv")
     except (OSError, csv.Error) as exc:

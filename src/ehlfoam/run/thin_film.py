@@ -23,7 +23,6 @@ exact (the model conserves the oil to round-off).
 
 from __future__ import annotations
 
-import fcntl
 import math
 import signal
 import time
@@ -34,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ehlfoam.case.geometry import META, CaseGeometry, load_geometry, load_spec_of
+from ehlfoam.case.ownership import hold_run_lock
 from ehlfoam.case.thin_film import START
 from ehlfoam.gap.field import GapField
 from ehlfoam.metrics.record import MetricsRecord, read_metrics, write_metrics
@@ -53,6 +53,8 @@ __all__ = ["STATE_FILE", "run_thin_film_case"]
 STATE_FILE = "state.npz"
 #: lines of the log a failed run's record keeps
 LOG_TAIL_LINES = 20
+#: end_reason of an earlier run whose process was killed (run.monitor's MONITOR_KILLED)
+MONITOR_KILLED = "monitor_killed"
 
 OnSample = Callable[[Sample, CaseGeometry], None]
 
@@ -60,27 +62,27 @@ OnSample = Callable[[Sample, CaseGeometry], None]
 def run_thin_film_case(case: str | Path, *, wall_limit: float | None = None,
                        on_sample: OnSample | None = None,
                        extend_transits: float | None = None,
-                       busy: type[Exception] = RuntimeError) -> MetricsRecord:
+                       crashed: Callable[[Path], MetricsRecord | None] | None = None,
+                       on_note: Callable[[str], None] | None = None) -> MetricsRecord:
     """March the thin-film case in ``case`` to its balance (or a limit) and write its
     metrics.json, history.csv, state.npz and log. ``wall_limit`` [s]: by default the
     spec's ``run.wall_limit``; ``extend_transits``: march that many transits past the state
-    the case has, whatever the steady-state test says; ``busy``: the exception raised when
-    another process runs the case (the run monitor's). Returns the record written."""
+    the case has, whatever the steady-state test says. The case's run lock
+    (:func:`ehlfoam.case.ownership.hold_run_lock`) is held throughout: another process
+    running it raises :class:`~ehlfoam.case.ownership.CaseBusy`. ``crashed``: called with
+    the case under the lock, the record of an earlier run that was killed (a ``running``
+    metrics.json), which ``on_note`` is told of. Returns the record written."""
     if extend_transits is not None and not extend_transits > 0:
         raise ValueError(f"extend_transits = {extend_transits!r} transits: it must be > 0")
     path = Path(case).absolute()
     spec, geom = load_spec_of(path), load_geometry(path)
-    lock = open(path / META / "run.lock", "w")
-    try:
-        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        lock.close()
-        raise busy(f"case {path} is being run by another process") from None
-    try:
+    with hold_run_lock(path):
+        if crashed is not None and crashed(path) is not None and on_note:
+            on_note(f"the earlier run of {path} was killed before it ended (metrics.json "
+                    f"said running, its run lock was free): marked interrupted "
+                    f"({MONITOR_KILLED}); this run goes on from its state")
         return _run_locked(path, spec, geom, wall_limit or spec.run.wall_limit, on_sample,
                            extend_transits)
-    finally:
-        lock.close()
 
 
 def _start(path: Path) -> tuple[ThinFilmSolution | None, float, list[Sample], float | None]:
@@ -164,6 +166,9 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
         end=Accounts.of(m, t0), oil_start=oil_start, oil_end=m.oil(),
         oil_initial=initial if initial is not None else 2.0 * oil_start, steps=m.steps,
         dt=m.dt, wall_s=wall, log_tail=tail)
+    if failure is not None:   # the one line a failed run's record gives (as the 3D runs')
+        record = record.updated(reason="the march failed: " + " ".join(
+            f"{type(failure).__name__}: {failure}".split())[:500])
     write_metrics(path, record)
     return record
 

@@ -26,7 +26,8 @@ from typing import Any
 
 from ehlfoam.spec.case import CaseSpec, make_case_spec
 from ehlfoam.case.geometry import CaseGeometry
-from ehlfoam.case.writer import CaseExists, write_case
+from ehlfoam.case.ownership import check_replaceable
+from ehlfoam.case.writer import write_case
 
 from ehlfoam.seed.band import meniscus_bands, meniscus_lines, side_bands
 from ehlfoam.seed.start import seed_case
@@ -81,13 +82,16 @@ def write_started_case(spec: CaseSpec, out: str | Path, source: str | Path | Non
     """Write ``spec``'s case in ``out`` and start it from ``source`` (None: the spec's own
     start); with ``mesh.follow`` its mesh follows the source's meniscus
     (:func:`following_spec`). Returns the case geometry and the seed's record (None without a
-    source). Raises ValueError for ``mesh.follow`` without a source (the case writer's)."""
-    out = Path(out)
+    source). Raises ValueError for ``mesh.follow`` without a source (the case writer's), and
+    :class:`~ehlfoam.case.ownership.CaseExists` for an ``out`` that may not be written (before
+    any work). The start is written into the case before it is renamed into place: a start
+    that fails leaves no case behind (and an earlier case it was to replace as it was)."""
+    out = Path(out).absolute()
+    check_replaceable(out, overwrite)
     if spec.mesh.follow is not None and source is not None:
-        if out.exists() and any(out.iterdir()) and not overwrite:
-            raise CaseExists(f"output folder {out} exists and is not empty (use --overwrite)")
         out.parent.mkdir(parents=True, exist_ok=True)
         spec = following_spec(spec, source, scratch=out.parent)
-    geom = write_case(spec, out, overwrite=overwrite)
-    seed = None if source is None else seed_case(out, source)
-    return geom, seed
+    seeded: list[dict[str, Any]] = []
+    prepare = None if source is None else (lambda tmp: seeded.append(seed_case(tmp, source)))
+    geom = write_case(spec, out, overwrite=overwrite, prepare=prepare)
+    return geom, (seeded[0] if seeded else None)

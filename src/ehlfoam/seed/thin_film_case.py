@@ -56,8 +56,9 @@ def check_thin_film_start(source: str | Path) -> Path:
                         "case or snapshot")
     try:
         load_state(state)
-    except (OSError, KeyError, ValueError) as err:
-        raise RampError(f"{source} is not a thin-film state ({err})") from None
+    except Exception as err:  # noqa: BLE001 - any damage: missing arrays, zlib, zip CRC
+        raise RampError(f"{source} is not a thin-film state ({type(err).__name__}: "
+                        f"{' '.join(str(err).split())[:200]})") from None
     return state
 
 

@@ -27,13 +27,13 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, get_origin
 
 from pydantic import BaseModel, Field, ValidationError, model_validator
 
 from ehlfoam._io import read_toml
 from ehlfoam.contact.spec import PrecalcSpec
-from ehlfoam.errors import SpecError, format_validation_error
+from ehlfoam.errors import SpecError, format_validation_error, models_in
 from ehlfoam.spec.levels import FOLLOW_POLAR_RADIUS, POLAR_RING_SHARE
 from ehlfoam.spec.mesh import Mesh
 from ehlfoam.spec.sections import STRICT, Domain, Physics, Run, Supply
@@ -185,15 +185,13 @@ def _drop_none(value):
 
 def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> CaseSpec:
     """Validate a case spec from nested data; ``overrides`` are dotted keys
-    (``{"contact.speed": 0.017}``) applied on top; None clears an optional key
-    (``{"mesh.polar_radius": None}``: free quads). Raises :class:`SpecError`."""
+    (``{"contact.speed": 0.017}``) applied on top; a table value merges key by key into the
+    data's table (``{"mesh": {"n_layers": 4}}`` keeps its other mesh keys); None clears an
+    optional key (``{"mesh.polar_radius": None}``: free quads). Types are strict: no bool
+    or string for a number. Raises :class:`SpecError`."""
     data = _deep_copy(data or {})
     for dotted, value in overrides.items():
-        node = data
-        *parents, leaf = dotted.split(".")
-        for p in parents:
-            node = node.setdefault(p, {})
-        node[leaf] = value
+        _set_dotted(data, dotted, value)
     try:
         spec = CaseSpec(**data)
     except ValidationError as err:
@@ -241,6 +239,51 @@ def _deep_copy(data):
     if isinstance(data, dict):
         return {k: _deep_copy(v) for k, v in data.items()}
     return data
+
+
+def _merge(into: dict[str, Any], table: dict[str, Any]) -> None:
+    """Merge ``table`` into ``into`` key by key (tables within tables too; other values
+    replace)."""
+    for key, value in table.items():
+        if isinstance(value, dict) and isinstance(into.get(key), dict):
+            _merge(into[key], value)
+        else:
+            into[key] = _deep_copy(value)
+
+
+def _set_dotted(data: dict[str, Any], dotted: str, value: Any) -> None:
+    """Set the override ``dotted`` = ``value`` in ``data``: each key before the last must be
+    a table of the case spec (:class:`SpecError` naming the key otherwise: ``contact.speed.x``
+    names no key, ``contact.speed`` is a number); a table value merges into the table there."""
+    *parents, leaf = dotted.split(".")
+    if not leaf or not all(parents):
+        raise SpecError(f"invalid case spec: {dotted!r} is not a dotted key (e.g. "
+                        f"contact.speed)")
+    model: type[BaseModel] = CaseSpec
+    node = data
+    for i, part in enumerate(parents):
+        name = ".".join(parents[:i + 1])
+        field = model.model_fields.get(part)
+        if field is None:
+            raise SpecError(f"invalid case spec: {name}: unknown key (valid here: "
+                            f"{', '.join(model.model_fields)}), in {dotted}")
+        tables = models_in(field.annotation)
+        if len(tables) != 1 or get_origin(field.annotation) in (tuple, list):
+            raise SpecError(f"invalid case spec: {dotted}: {name} is a value, not a table "
+                            f"(set it as {name}=VALUE)")
+        model = tables[0]
+        child = node.get(part)
+        if child is None:
+            child = node[part] = {}
+        elif isinstance(child, BaseModel):      # a table given as a model: its values
+            child = node[part] = child.model_dump()
+        elif not isinstance(child, dict):
+            raise SpecError(f"invalid case spec: {dotted}: {name} = {child!r} is not a table")
+        node = child
+    if isinstance(value, dict) and isinstance(node.get(leaf), dict):
+        _merge(node[leaf], value)
+    else:
+        node[leaf] = value
 
 
 def load_case_spec(path: str | Path, **overrides: Any) -> CaseSpec:

@@ -10,10 +10,11 @@ from __future__ import annotations
 from typing import Annotated, Any, Literal, Union
 
 import numpy as np
-from pydantic import BaseModel, Discriminator, Field, Tag, field_validator, model_validator
+from pydantic import (BaseModel, BeforeValidator, Discriminator, Field, Tag, field_validator,
+                      model_validator)
 
 from ehlfoam.spec.levels import FOLLOW_BASE, FOLLOW_LEVELS, POLAR_RING_SHARE, RESOLUTIONS
-from ehlfoam.spec.sections import STRICT
+from ehlfoam.spec.sections import STRICT, as_tuples
 
 
 class RefineBox(BaseModel):
@@ -49,7 +50,7 @@ class RefineBand(BaseModel):
     bands that follow a run's mid-gap meniscus."""
 
     model_config = STRICT
-    points: tuple[tuple[float, float], ...] = Field(
+    points: Annotated[tuple[tuple[float, float], ...], BeforeValidator(as_tuples)] = Field(
         min_length=2, max_length=10_000,
         description="The points (x, |y|) of the polyline the band follows (a half domain's "
                     "line serves the full domain too).",
@@ -181,7 +182,7 @@ class Mesh(BaseModel):
                     'meet every layer at right angles (an in-plane shift of a few um at most); '
                     '"vertical" keeps them upright, which makes every face where the ball '
                     'slopes non-orthogonal.')
-    refine: tuple[Refinement, ...] = Field(
+    refine: Annotated[tuple[Refinement, ...], BeforeValidator(as_tuples)] = Field(
         (),
         description="Boxes and bands along a line of finer in-plane cells (free quads only), "
                     "e.g. [{x_min = 5, x_max = 14, y_max = 8, size = 0.1}] where the rear "
@@ -192,6 +193,11 @@ class Mesh(BaseModel):
         description="A mesh that follows the meniscus of the state the case starts from "
                     "(--start-from): the level then sets the bands' cells and the wall cell, "
                     "on FOLLOW_BASE. None: the levels of RESOLUTIONS.")
+    max_cells: int = Field(
+        5_000_000, ge=1, le=10**9,
+        description="The most cells a case's mesh may have: a spec whose mesh, estimated from "
+                    "its sizes (in-plane quads x n_layers) before anything is meshed, exceeds "
+                    "it is refused with the estimate. A bound on the work, not on the result.")
 
     @field_validator("polar_radius", mode="before")
     @classmethod

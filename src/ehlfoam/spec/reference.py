@@ -280,7 +280,16 @@ def render(documents: tuple[Document, ...] = DOCUMENTS) -> str:
             "(`[[key]]`). Values are in SI units unless the unit column says otherwise; the "
             "valid range is written as an error message states it. A value outside it stops "
             "the command before anything is written, with a message naming the key, the value "
-            "and the range.", ""]
+            "and the range.", "",
+            "Types are strict: a number is a number (an integer serves where a number is "
+            "wanted: TOML writes `20` for `20.0`), never `true` or a string (`load = \"25\"` "
+            "and `n_layers = true` are refused); an integer is an integer (`n_layers = 3`, not "
+            "`3.0`). `--set KEY=VALUE` reads VALUE as TOML: a number, `true`/`false`, a quoted "
+            "string (`\"0.02\"` is a string, refused where a number is wanted), a `[list]`, "
+            "an `{inline table}`, or a bare word that is not TOML, which is a string "
+            "(`--set mesh.resolution=coarse`); `none` clears an optional key. An inline table "
+            "merges key by key into the spec's table: `--set 'mesh={n_layers = 4}'` changes "
+            "`mesh.n_layers` and keeps the file's other `[mesh]` keys.", ""]
     return "\n".join(head + [render_document(d) for d in documents]).rstrip() + "\n"
 
 

@@ -11,13 +11,22 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-#: Every table of a spec: unknown keys are refused, values frozen, NaN and inf refused.
-STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+#: Every table of a spec: unknown keys are refused, values frozen, NaN and inf refused, and
+#: types strict (pydantic's strict mode): no true for a number, no "25" for a number, no 2.0
+#: for an integer; an integer is a number (TOML writes 20 for 20.0). A list is a tuple only
+#: through :func:`as_tuples` (TOML has no tuples).
+STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+
+
+def as_tuples(value: Any) -> Any:
+    """A before-validator of a tuple field of a strict model: TOML and JSON arrays (lists,
+    nested too) become tuples, their items unchanged (and validated strictly)."""
+    return tuple(as_tuples(v) for v in value) if isinstance(value, list) else value
 
 
 class Supply(BaseModel):
@@ -316,3 +325,9 @@ class Run(BaseModel):
     n_procs: int = Field(
         1, ge=1, le=1024,
         description="MPI ranks (1: serial).")
+    max_steps: int = Field(
+        10_000_000, ge=1, le=10**12,
+        description="The most time steps a case may take to its end time: a case whose end "
+                    "time over its largest time step (the capillary limit on the smallest "
+                    "cell, or the write interval) exceeds it is refused before it is built, "
+                    "with the estimate. A bound on the work, not on the result.")
