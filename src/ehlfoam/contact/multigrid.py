@@ -18,16 +18,20 @@ from __future__ import annotations
 
 import math
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
+import numba
 import numpy as np
 from scipy.ndimage import minimum_filter
 
 from ehlfoam.contact.elastic import Deformation, hertz_pressure
-from ehlfoam.contact.lubricant import PressureLaws
-from ehlfoam.contact.reynolds import relax, residual
+from ehlfoam.contact.lubricant import PressureLaws, coefficients, coefficients_parallel
+from ehlfoam.contact.reynolds import relax, residual, residual_parallel
 
 LOAD_TARGET = 2.0 * math.pi / 3.0
+#: Grids with fewer points than this run on one thread (threads cost more than they save).
+PARALLEL_MIN_POINTS = 300_000
 
 
 @dataclass(frozen=True)
@@ -58,6 +62,8 @@ class SolverOptions:
     stall_window, stall_ratio: the cycles stall when the best residual of the last
         ``stall_window`` cycles is not below ``stall_ratio`` times the best of the window
         before; the solve then goes on with :meth:`stalled` options (once).
+    workers: threads of the solve (scipy.fft and the numba kernels); None: the caller's
+        numba thread count (:func:`solve_threads`).
     """
 
     nu1: int = 2
@@ -78,6 +84,7 @@ class SolverOptions:
     limit_correction: bool = False
     stall_window: int = 8
     stall_ratio: float = 0.7
+    workers: int | None = None
 
     def stalled(self) -> "SolverOptions":
         """Options for the rest of a stalled solve (large L: a limit cycle between the pressure
@@ -98,16 +105,24 @@ class Problem:
     neumann_outlet: bool = False
     moes_M: float = 100.0
 
+    @property
+    def params(self) -> np.ndarray:
+        """The pressure laws' parameter vector for the numba kernels."""
+        return self.laws.kernel_params()
+
 
 class Level:
     """One grid of the hierarchy with its FAS data."""
 
-    def __init__(self, nx: int, ny: int, x0: float, y0: float, h: float):
+    def __init__(self, nx: int, ny: int, x0: float, y0: float, h: float, workers: int = 1):
         self.nx, self.ny, self.h = nx, ny, h
         self.x = x0 + h * np.arange(nx)
         self.y = y0 + h * np.arange(ny)
         self.rigid = 0.5 * self.x[None, :] ** 2 + 0.5 * self.y[:, None] ** 2
-        self.deform = Deformation(nx, ny, h, h)
+        self.workers = workers if nx * ny >= PARALLEL_MIN_POINTS else 1
+        self.deform = Deformation(nx, ny, h, h, workers=self.workers)
+        self._coefficients = coefficients_parallel if self.workers > 1 else coefficients
+        self._residual = residual_parallel if self.workers > 1 else residual
         self.K0 = np.ascontiguousarray(self.deform.kernel[0, :6])
         self.K1 = np.ascontiguousarray(self.deform.kernel[1, :6])
         self.P = np.zeros((ny, nx))
@@ -115,51 +130,83 @@ class Level:
         self.tauW = np.zeros((ny, nx))
         self.load_target = LOAD_TARGET
         self.work = np.zeros((ny, nx))
+        self._coef = [np.empty((ny, nx)) for _ in range(5)]
+        self._W_of: np.ndarray | None = None  # the pressure whose deformation is self._W
+        self._W = np.zeros((ny, nx))
 
     def load(self, P: np.ndarray) -> float:
         return self.h * self.h * float(P.sum())
 
+    def deformation(self, P: np.ndarray) -> np.ndarray:
+        """W(P) by DC-FFT, remembered for the last pressure (a sweep, the residual and the
+        convergence check often ask for the same one)."""
+        if self._W_of is None or not np.array_equal(self._W_of, P):
+            self._W = self.deform(P)
+            self._W_of = P.copy()
+        return self._W
+
     def film(self, P: np.ndarray, H0: float) -> np.ndarray:
-        return H0 + self.rigid + self.deform(P) + self.tauW
+        return H0 + self.rigid + self.deformation(P) + self.tauW
 
     def coefficients(self, P: np.ndarray, H0: float, prob: Problem, H: np.ndarray | None = None):
-        """(H, rho, drho, eps) at pressure P; the film is computed unless given."""
+        """(H, rho, drho, eps, deps, ln_eta) at pressure P (arrays owned by the level, valid
+        until its next call); the film is computed unless given."""
         if H is None:
             H = self.film(P, H0)
-        rho, drho = prob.laws.rho(P)
-        eta = prob.laws.eta(P)
-        eps = rho * np.maximum(H, 0.0) ** 3 / (eta * prob.lam)
-        return H, rho, drho, eps
+        rho, drho, eps, deps, ln_eta = self._coef
+        self._coefficients(P, H, prob.lam, prob.params, rho, drho, eps, deps, ln_eta)
+        return H, rho, drho, eps, deps, ln_eta
 
     def residual(self, P: np.ndarray, H0: float, prob: Problem, f: np.ndarray | None = None,
                  raw: bool = False, H: np.ndarray | None = None):
         """(r, wedge, H) with r = f - L(P); unless ``raw``, r is zeroed where cavitation
         holds (P = 0, r > 0: the diverging gap would pull P below 0)."""
-        H, rho, _, eps = self.coefficients(P, H0, prob, H)
+        H, rho, _, eps, _, _ = self.coefficients(P, H0, prob, H)
         r = np.zeros_like(P)
         wedge = np.zeros_like(P)
-        residual(P, rho * H, eps, self.f if f is None else f, self.h, self.h, r, wedge)
+        self._residual(P, rho * H, eps, self.f if f is None else f, self.h, self.h, r, wedge)
         if not raw:
             r[(P <= prob.p_floor) & (r > 0.0)] = 0.0
         return r, wedge, H
 
     def relax(self, H0: float, prob: Problem, opt: SolverOptions) -> None:
-        H, rho, drho, eps = self.coefficients(self.P, H0, prob)
+        H, rho, drho, eps, deps, ln_eta = self.coefficients(self.P, H0, prob)
         P_old = self.P.copy() if opt.max_ln_eta_step > 0.0 else None
-        deps = -eps * prob.laws.dln_eta_dP(self.P)
         relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
               opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet, self.work,
               deps)
         if P_old is not None:
-            limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step)
+            limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step, ln_eta)
             if prob.neumann_outlet:
                 self.P[:, -1] = self.P[:, -2]
 
 
+def solve_threads(workers: int | None = None) -> int:
+    """Threads a solve uses, the one setting for both scipy.fft and the numba kernels:
+    ``workers`` if given, else the calling thread's numba thread count, which a batch sets to
+    the cores it gives the job (``numba.set_num_threads``), the environment sets by
+    ``NUMBA_NUM_THREADS``, and which is otherwise the cores this process may run on; never
+    more than numba's thread pool."""
+    n = numba.get_num_threads() if workers is None else int(workers)
+    return max(1, min(n, numba.config.NUMBA_NUM_THREADS))
+
+
+@contextmanager
+def numba_threads(n: int):
+    """Run the numba kernels of the block on ``n`` threads (the previous count restored)."""
+    prev = numba.get_num_threads()
+    numba.set_num_threads(n)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(prev)
+
+
 def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
-                         max_step: float) -> None:
+                         max_step: float, ln_eta_old: np.ndarray | None = None) -> None:
     """Damp a relaxation sweep where it would change the viscosity by more than a factor
-    e^max_step; updates the dimensionless pressure ``P`` in place.
+    e^max_step; updates the dimensionless pressure ``P`` in place (``ln_eta_old``: the laws'
+    ln(eta / eta0) at ``P_old`` where known).
 
     The line systems hold eps = rho H^3 / (eta lambda) frozen, so where the pressure-viscosity
     product alpha pH is large (Moes L >= 20) a step of a few tenths in P changes eta by orders
@@ -168,11 +215,13 @@ def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
     fixed point (the limiter is inactive once the steps are small) and only slows the first
     sweeps of a large-L solve.
     """
-    dP = P - P_old
-    d_ln_eta = np.abs(laws.ln_eta(P) - laws.ln_eta(P_old))
+    if ln_eta_old is None:
+        ln_eta_old = laws.ln_eta(P_old)
+    d_ln_eta = np.abs(laws.ln_eta(P) - ln_eta_old)
     big = d_ln_eta > max_step
     if np.any(big):
-        P[big] = P_old[big] + dP[big] * (max_step / d_ln_eta[big])
+        dP = P[big] - P_old[big]
+        P[big] = P_old[big] + dP * (max_step / d_ln_eta[big])
 
 
 def _restrict_full_weighting(r: np.ndarray) -> np.ndarray:
@@ -238,7 +287,9 @@ class MultigridSolver:
                and (ny - 1) % 2 == 0):
             nx, ny, h = (nx - 1) // 2 + 1, (ny - 1) // 2 + 1, 2 * h
             sizes.append((nx, ny, h))
-        self.levels = [Level(n1, n2, dom.x_min, -dom.y_half, hh) for n1, n2, hh in reversed(sizes)]
+        self.workers = solve_threads(self.opt.workers)
+        self.levels = [Level(n1, n2, dom.x_min, -dom.y_half, hh, self.workers)
+                       for n1, n2, hh in reversed(sizes)]
         self.H0 = 0.0
         # the film constant reacts strongly to the load when heavily loaded: smaller steps
         self.h0_gain = self.opt.h0_gain * (0.25 if prob.moes_M > 1000.0 else 1.0)
@@ -313,7 +364,12 @@ class MultigridSolver:
 
     # --- driver ---------------------------------------------------------------------------
     def solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
-        """Solve from a Hertzian start by FMG, or from ``P_init`` (finest grid) by cycles."""
+        """Solve from a Hertzian start by FMG, or from ``P_init`` (finest grid) by cycles,
+        on :attr:`workers` threads."""
+        with numba_threads(self.workers):
+            return self._solve(H0_guess, P_init)
+
+    def _solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
         t0 = time.perf_counter()
         opt = base_opt = self.opt
         self.H0 = H0_guess

@@ -18,7 +18,7 @@ near elastic influence coefficients along the line.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 @njit(cache=True)
@@ -46,19 +46,23 @@ def _residual_at(P, rhoH, eps, f, j, i, hx2, hy2, hx):
     return f[j, i] - (pois - wedge / hx), wedge / hx
 
 
-@njit(cache=True)
-def residual(P, rhoH, eps, f, hx, hy, r, wedge):
+def _residual(P, rhoH, eps, f, hx, hy, r, wedge):
     """Residual r = f - L(P) and the wedge term at interior points (boundaries 0)."""
     ny, nx = P.shape
     hx2, hy2 = hx * hx, hy * hy
     r[:] = 0.0
     wedge[:] = 0.0
-    for j in range(1, ny - 1):
+    for j in prange(1, ny - 1):
         for i in range(1, nx - 1):
             rr, ww = _residual_at(P, rhoH, eps, f, j, i, hx2, hy2, hx)
             r[j, i] = rr
             wedge[j, i] = ww
     return r
+
+
+#: :func:`_residual` on one thread and on numba's threads (large grids)
+residual = njit(cache=True)(_residual)
+residual_parallel = njit(parallel=True, cache=True)(_residual)
 
 
 @njit(cache=True)
