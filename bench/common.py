@@ -15,7 +15,11 @@ from typing import Any
 RESULTS = Path(__file__).resolve().parent / "results"
 
 
-def _child(spec_kwargs: dict, options: dict | None, queue) -> None:
+def _child(spec_kwargs: dict, options: dict | None, queue, workers: int | None = None) -> None:
+    import os
+
+    if workers:  # the one thread setting of a solve (numba's count, read by the solver)
+        os.environ["NUMBA_NUM_THREADS"] = str(workers)
     from ehlfoam.contact.multigrid import SolverOptions
     from ehlfoam.contact.solver import solve
     from ehlfoam.contact.spec import make_spec
@@ -26,7 +30,7 @@ def _child(spec_kwargs: dict, options: dict | None, queue) -> None:
     if options:
         opt = SolverOptions(**{"max_cycles": spec.max_cycles, "tol_residual": spec.tol_residual,
                                "tol_load": spec.tol_load, **options})
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         result = solve(spec, opt)
         summary = result.summary()
@@ -34,15 +38,20 @@ def _child(spec_kwargs: dict, options: dict | None, queue) -> None:
     except Exception as err:  # noqa: BLE001 - a failed point of a map is data
         summary = {"converged": False, "failure": f"{type(err).__name__}: {err}", "nan": True}
     summary["wall_s"] = time.perf_counter() - t0
+    summary["cpu_s"] = time.process_time() - c0
     summary["peak_rss_GiB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
+    summary["load_average"] = os.getloadavg()
     queue.put(summary)
 
 
-def solve_in_subprocess(spec_kwargs: dict, options: dict | None = None) -> dict:
-    """Solve in a fresh process; returns the summary plus wall_s and peak_rss_GiB."""
+def solve_in_subprocess(spec_kwargs: dict, options: dict | None = None,
+                        workers: int | None = None) -> dict:
+    """Solve in a fresh process on ``workers`` threads (default: the solver's own choice);
+    returns the summary plus wall_s, cpu_s (the process's CPU time), peak_rss_GiB and the
+    machine's load_average at the end."""
     ctx = mp.get_context("spawn")
     q = ctx.Queue()
-    p = ctx.Process(target=_child, args=(spec_kwargs, options, q))
+    p = ctx.Process(target=_child, args=(spec_kwargs, options, q, workers))
     p.start()
     out = q.get()
     p.join()

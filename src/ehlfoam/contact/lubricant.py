@@ -130,6 +130,15 @@ class PressureLaws:
         cap :data:`ETA_LN_CAP`)."""
         return self._viscosity(P)[1]
 
+    def max_dln_eta_dP(self, P_max: float) -> float:
+        """The largest d ln(eta / eta0) / dP over 0 <= P <= ``P_max``: alpha pH for Barus and
+        for Roelands with z <= 1 (its slope falls with pressure from alpha at ambient), else
+        the largest on 1024 steps (monotone up to the cap; 1 % margin)."""
+        lub = self.lubricant
+        if self.viscosity == "barus" or lub.roelands_z <= 1.0:
+            return lub.alpha * self.p_hertz
+        return 1.01 * float(self.dln_eta_dP(np.linspace(0.0, max(P_max, 0.0), 1025)).max())
+
     def _viscosity(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         P = np.ascontiguousarray(P, dtype=float)
         ln_eta, dln = np.empty_like(P), np.empty_like(P)

@@ -27,7 +27,7 @@ from scipy.ndimage import minimum_filter
 
 from ehlfoam.contact.elastic import Deformation, hertz_pressure
 from ehlfoam.contact.lubricant import PressureLaws, coefficients, coefficients_parallel
-from ehlfoam.contact.reynolds import relax, residual, residual_parallel
+from ehlfoam.contact.reynolds import relax, relax_parallel, residual, residual_parallel
 
 LOAD_TARGET = 2.0 * math.pi / 3.0
 #: Grids with fewer points than this run on one thread (threads cost more than they save).
@@ -53,8 +53,26 @@ class Domain:
 class SolverOptions:
     """Multigrid and convergence settings (dimensionless).
 
+    nu1, nu2, gamma: sweeps before and after the coarse-grid correction; 2: W-cycles.
+    switch, w_gs, w_ja: Gauss-Seidel where eps / h^2 >= switch, distributive Jacobi
+        elsewhere; their under-relaxation factors.
+    w_ja_high_L, high_L: the distributive-Jacobi factor above Moes L = ``high_L`` (a sharp
+        pressure spike: 0.5 stalls there, 0.2 does not; below, 0.5 needs half the cycles of
+        0.2 at M = 1000-4000).
+    zebra: the odd lines first, then the even ones (parallel; else in order).
+    coarsest_min_points: the coarsest grid has at most this many points a side.
+    coarse_sweeps, coarse_rounds, h0_gain: the coarsest level is solved by
+        ``coarse_rounds`` rounds of ``coarse_sweeps`` sweeps, each round followed by a step
+        H0 += gain (load - target) (a quarter of ``h0_gain`` above Moes M 1000): with the
+        coarse problem solved, the film constant is right after a cycle or two.
+    fmg_cycles, fmg_max_cycles, fmg_change: full-multigrid start, see
+        :meth:`MultigridSolver._fmg`.
     tol_residual: relative Reynolds residual sum|r| / sum|d(rho H)/dX| to reach.
     tol_load: relative load-balance error to reach.
+    film_fraction, film_rel_min, film_rel_max, film_max_residual: the solve has also
+        converged (load error below ``tol_load``) once a cycle changes the central and the
+        minimum film by less than :meth:`MultigridSolver.film_tolerance` with the residual
+        below ``film_max_residual``: the film, not the residual, is what the precalc is for.
     max_ln_eta_step: largest change of ln(eta / eta0) one relaxation sweep may make at a
         point (see :func:`limit_viscosity_step`); 0 switches the limiter off.
     limit_correction: hold the coarse-grid correction to the same viscosity-step limit as
@@ -67,16 +85,24 @@ class SolverOptions:
     """
 
     nu1: int = 2
-    nu2: int = 1
+    nu2: int = 2
     gamma: int = 2
     switch: float = 0.3
     w_gs: float = 0.4
-    w_ja: float = 0.2
+    w_ja: float = 0.5
+    w_ja_high_L: float = 0.2
+    high_L: float = 15.0
     coarsest_min_points: int = 33
-    coarse_sweeps: int = 10
-    coarse_rounds: int = 1
+    coarse_sweeps: int = 5
+    coarse_rounds: int = 10
     h0_gain: float = 0.05
     fmg_cycles: int = 2
+    fmg_max_cycles: int = 8
+    fmg_change: float = 0.2
+    film_fraction: float = 0.1
+    film_rel_min: float = 1e-4
+    film_rel_max: float = 1e-3
+    film_max_residual: float = 1e-3
     max_cycles: int = 100
     tol_residual: float = 3e-5
     tol_load: float = 3e-5
@@ -85,6 +111,7 @@ class SolverOptions:
     stall_window: int = 8
     stall_ratio: float = 0.7
     workers: int | None = None
+    zebra: bool = True
 
     def stalled(self) -> "SolverOptions":
         """Options for the rest of a stalled solve (large L: a limit cycle between the pressure
@@ -104,6 +131,7 @@ class Problem:
     p_floor: float = 0.0
     neumann_outlet: bool = False
     moes_M: float = 100.0
+    moes_L: float = 0.0
 
     @property
     def params(self) -> np.ndarray:
@@ -123,6 +151,7 @@ class Level:
         self.deform = Deformation(nx, ny, h, h, workers=self.workers)
         self._coefficients = coefficients_parallel if self.workers > 1 else coefficients
         self._residual = residual_parallel if self.workers > 1 else residual
+        self._relax = relax_parallel if self.workers > 1 else relax
         self.K0 = np.ascontiguousarray(self.deform.kernel[0, :6])
         self.K1 = np.ascontiguousarray(self.deform.kernel[1, :6])
         self.P = np.zeros((ny, nx))
@@ -130,6 +159,7 @@ class Level:
         self.tauW = np.zeros((ny, nx))
         self.load_target = LOAD_TARGET
         self.work = np.zeros((ny, nx))
+        self.sweeps = 0  # relaxation sweeps done on this level (work accounting)
         self._coef = [np.empty((ny, nx)) for _ in range(5)]
         self._W_of: np.ndarray | None = None  # the pressure whose deformation is self._W
         self._W = np.zeros((ny, nx))
@@ -170,11 +200,12 @@ class Level:
         return r, wedge, H
 
     def relax(self, H0: float, prob: Problem, opt: SolverOptions) -> None:
+        self.sweeps += 1
         H, rho, drho, eps, deps, ln_eta = self.coefficients(self.P, H0, prob)
         P_old = self.P.copy() if opt.max_ln_eta_step > 0.0 else None
-        relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
-              opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet, self.work,
-              deps)
+        self._relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
+                    opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet,
+                    self.work, deps, True, opt.zebra)
         if P_old is not None:
             limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step, ln_eta)
             if prob.neumann_outlet:
@@ -215,6 +246,9 @@ def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
     fixed point (the limiter is inactive once the steps are small) and only slows the first
     sweeps of a large-L solve.
     """
+    dP_max = float(np.max(np.abs(P - P_old)))
+    if dP_max * laws.max_dln_eta_dP(max(float(P.max()), float(P_old.max()))) <= max_step:
+        return  # no point can have changed ln(eta) by more than max_step
     if ln_eta_old is None:
         ln_eta_old = laws.ln_eta(P_old)
     d_ln_eta = np.abs(laws.ln_eta(P) - ln_eta_old)
@@ -245,6 +279,30 @@ def _restrict_pressure(P: np.ndarray, p_floor: float) -> np.ndarray:
     return Pc
 
 
+def _cubic_midpoints(c: np.ndarray, axis: int) -> np.ndarray:
+    """Values halfway between the points of ``c`` along ``axis``: four-point (cubic)
+    interpolation, two-point next to the ends."""
+    c = np.moveaxis(c, axis, 0)
+    mid = 0.5 * (c[:-1] + c[1:])
+    if c.shape[0] >= 4:
+        mid[1:-1] = (9.0 * (c[1:-2] + c[2:-1]) - (c[:-3] + c[3:])) / 16.0
+    return np.moveaxis(mid, 0, axis)
+
+
+def _prolong_cubic(c: np.ndarray) -> np.ndarray:
+    """Fourth-order (cubic) interpolation to the next finer grid: the FMG interpolation of
+    the pressure (Venner & Lubrecht), whose O(h^4) error leaves the film's O(h^2)
+    discretisation error of the finer grid to the cycles."""
+    ny, nx = 2 * c.shape[0] - 1, 2 * c.shape[1] - 1
+    rows = np.empty((c.shape[0], nx))
+    rows[:, ::2] = c
+    rows[:, 1::2] = _cubic_midpoints(c, 1)
+    f = np.empty((ny, nx))
+    f[::2] = rows
+    f[1::2] = _cubic_midpoints(rows, 0)
+    return f
+
+
 def _prolong_bilinear(c: np.ndarray) -> np.ndarray:
     ny, nx = 2 * c.shape[0] - 1, 2 * c.shape[1] - 1
     f = np.zeros((ny, nx))
@@ -272,6 +330,10 @@ class MGResult:
     failure: str = ""
     #: cycle after which the stalled-solve options were used (None: never)
     stalled_at: int | None = None
+    #: central film of each FMG level below the finest (its discretisation-error estimate)
+    fmg_hc: list = field(default_factory=list)
+    #: relaxation sweeps of all levels in units of one finest-level sweep
+    work_units: float = 0.0
 
 
 class MultigridSolver:
@@ -354,13 +416,24 @@ class MultigridSolver:
         res = [h[1] for h in history]
         return min(res[-w:]) > self.opt.stall_ratio * min(res[-2 * w:-w])
 
-    def measure(self) -> tuple[float, float, MGResult | None]:
-        lv = self.levels[-1]
+    def measure(self, k: int | None = None) -> tuple[float, float, np.ndarray]:
+        """(relative residual, relative load error, film) of level ``k`` (default: finest)."""
+        lv = self.levels[-1 if k is None else k]
         r, wedge, H = lv.residual(lv.P, self.H0, self.prob)
         denom = float(np.abs(wedge).sum()) or 1.0
         res = float(np.abs(r).sum()) / denom
         load_err = abs(lv.load(lv.P) - lv.load_target) / lv.load_target
         return res, load_err, H
+
+    def work_units(self) -> float:
+        """Relaxation sweeps done so far on all levels, in finest-level sweeps (each weighted
+        by its points)."""
+        top = self.levels[-1]
+        return sum(lv.sweeps * lv.nx * lv.ny for lv in self.levels) / (top.nx * top.ny)
+
+    def _centre(self, k: int) -> tuple[int, int]:
+        lv = self.levels[k]
+        return int(np.argmin(np.abs(lv.y))), int(np.argmin(np.abs(lv.x)))
 
     # --- driver ---------------------------------------------------------------------------
     def solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
@@ -369,57 +442,112 @@ class MultigridSolver:
         with numba_threads(self.workers):
             return self._solve(H0_guess, P_init)
 
+    def _fmg(self) -> list[float]:
+        """Full multigrid start: the coarsest level from a Hertzian pressure, then each finer
+        level from the cubic interpolation of the coarser one, cycled until its central film
+        changes by less than ``fmg_change`` times the discretisation error that the two
+        levels estimate (|hc_k - hc_k-1| / 3, second order), at least ``fmg_cycles`` and at
+        most ``fmg_max_cycles`` cycles. The finest level is left interpolated (the caller
+        cycles it). Returns the central film of each level below the finest."""
+        opt = self.opt
+        self.fmg_counts = []
+        lv0 = self.levels[0]
+        X, Y = np.meshgrid(lv0.x, lv0.y)
+        lv0.P = hertz_pressure(X, Y)
+        self._enforce_bc(lv0)
+        self._solve_coarsest()
+        j, i = self._centre(0)
+        hc = [float(lv0.film(lv0.P, self.H0)[j, i])]
+        for k in range(1, len(self.levels)):
+            lv = self.levels[k]
+            lv.P = _prolong_cubic(self.levels[k - 1].P)
+            lv.f[:] = 0.0
+            lv.tauW[:] = 0.0
+            lv.load_target = LOAD_TARGET
+            self._enforce_bc(lv)
+            if k == len(self.levels) - 1:
+                break
+            j, i = self._centre(k)
+            last = None
+            for n in range(opt.fmg_max_cycles):
+                self._cycle(k)
+                H = lv.film(lv.P, self.H0)
+                now = (float(H[j, i]), float(H.min()))
+                if (n + 1 >= opt.fmg_cycles and last is not None and np.all(np.isfinite(now))
+                        and max(abs(now[0] - last[0]), abs(now[1] - last[1]))
+                        < opt.fmg_change * abs(now[0] - hc[-1]) / 3.0):
+                    break
+                last = now
+            hc.append(now[0])
+            self.fmg_counts.append(n + 1)
+        return hc
+
+    def film_tolerance(self, hc: float, hc_coarse: float | None) -> float:
+        """Largest cycle-to-cycle change of the central and minimum film (units a^2/R) at
+        which the finest level counts as converged: ``film_fraction`` of its discretisation
+        error estimated from the FMG levels (|hc - hc_coarse| / 3), held between
+        ``film_rel_min`` and ``film_rel_max`` times hc (``film_rel_max`` without a coarse
+        estimate)."""
+        opt = self.opt
+        top = opt.film_rel_max * abs(hc)
+        if hc_coarse is None or not np.isfinite(hc_coarse):
+            return top
+        tol = opt.film_fraction * abs(hc - hc_coarse) / 3.0
+        return float(np.clip(tol, opt.film_rel_min * abs(hc), top))
+
     def _solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
         t0 = time.perf_counter()
-        opt = base_opt = self.opt
+        base_opt = self.opt
+        if self.prob.moes_L > base_opt.high_L:
+            self.opt = replace(base_opt, w_ja=base_opt.w_ja_high_L)
+        opt = self.opt
         self.H0 = H0_guess
         history = []
         if P_init is not None:
             self.levels[-1].P = P_init.copy()
             self._enforce_bc(self.levels[-1])
-            fmg_levels = []
+            fmg_hc = []
         else:
-            lv0 = self.levels[0]
-            X, Y = np.meshgrid(lv0.x, lv0.y)
-            lv0.P = hertz_pressure(X, Y)
-            self._enforce_bc(lv0)
-            self._solve_coarsest()
-            fmg_levels = range(1, len(self.levels))
-        # FMG: solve on each level, interpolate upwards
-        for k in fmg_levels:
-            self.levels[k].P = _prolong_bilinear(self.levels[k - 1].P)
-            self.levels[k].f[:] = 0.0
-            self.levels[k].tauW[:] = 0.0
-            self.levels[k].load_target = LOAD_TARGET
-            self._enforce_bc(self.levels[k])
-            for _ in range(opt.fmg_cycles):
-                self._cycle(k)
+            fmg_hc = self._fmg()
+        top = len(self.levels) - 1
         lv = self.levels[-1]
+        j, i = self._centre(top)
         converged = False
         failure = ""
         cycles = 0
         stalled_at = None
+        film_ok = 0
         res, load_err, H = self.measure()
-        history.append((0, res, load_err, self.H0, time.perf_counter() - t0))
-        while cycles < opt.max_cycles:
+        films = [(float(H[j, i]), float(H.min()))]
+        history.append((0, res, load_err, self.H0, time.perf_counter() - t0, *films[-1]))
+        while True:
             if not np.isfinite(res) or not np.all(np.isfinite(lv.P)):
                 failure = "non-finite pressure or residual"
                 break
-            if res < opt.tol_residual and load_err < opt.tol_load:
+            if load_err < opt.tol_load and (res < opt.tol_residual
+                                            or (film_ok and res < opt.film_max_residual)):
                 converged = True
+                break
+            if cycles >= opt.max_cycles:
                 break
             if self._stalled(history):
                 self.opt = opt = opt.stalled()
                 stalled_at = cycles
-            self._cycle(len(self.levels) - 1)
+            self._cycle(top)
             cycles += 1
             res, load_err, H = self.measure()
-            history.append((cycles, res, load_err, self.H0, time.perf_counter() - t0))
+            films.append((float(H[j, i]), float(H.min())))
+            tol = self.film_tolerance(films[-1][0], fmg_hc[-1] if fmg_hc else None)
+            change = max(abs(films[-1][0] - films[-2][0]), abs(films[-1][1] - films[-2][1]))
+            film_ok = film_ok + 1 if change < tol else 0
+            history.append((cycles, res, load_err, self.H0, time.perf_counter() - t0,
+                            *films[-1]))
         self.opt = base_opt  # the stalled options hold for this solve only
         if not converged and not failure:
             failure = (f"not converged after {cycles} cycles: residual {res:.3g} "
                        f"(tol {opt.tol_residual:g}), load error {load_err:.3g} (tol {opt.tol_load:g})")
         return MGResult(P=lv.P.copy(), H=H, H0=self.H0, x=lv.x.copy(), y=lv.y.copy(),
+                        work_units=self.work_units(),
                         converged=converged, residual=res, load_error=load_err, cycles=cycles,
                         history=history, wall_s=time.perf_counter() - t0, failure=failure,
-                        stalled_at=stalled_at)
+                        stalled_at=stalled_at, fmg_hc=fmg_hc)

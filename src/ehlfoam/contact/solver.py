@@ -15,8 +15,8 @@ from ehlfoam.contact.multigrid import Domain, MGResult, MultigridSolver, Problem
 from ehlfoam.contact.spec import P_AMBIENT_PA, PrecalcSpec
 from ehlfoam.contact.twophase import SubAmbientResult, solve_subambient
 
-#: Above this Moes M (or when a direct start fails) the solve starts from a solution at a
-#: lower M (speed ramp).
+#: When a direct (FMG) start fails, the solve starts again from a solution at a Moes M of
+#: at most this (speed ramp).
 CONTINUATION_M = 5000.0
 #: Multigrid cycles spent on each intermediate step of the speed ramp.
 RAMP_CYCLES = 4
@@ -148,11 +148,12 @@ def _ramp(solver, prob, opt, c, factor: float, start: float, h0_guess):
 
 
 def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcResult:
-    """Solve the EHL contact of ``spec``.
+    """Solve the EHL contact of ``spec``: full multigrid from a Hertzian start, then cycles
+    to convergence (:class:`~ehlfoam.contact.multigrid.MultigridSolver`).
 
-    Above :data:`CONTINUATION_M` (or when a direct start fails) the solution is reached by a
-    speed ramp: M is stepped up by factors of at most 2 from a directly solvable M, each step
-    starting from the previous converged pressure and film constant.
+    Only when that direct start fails is the solution reached by a speed ramp: M is stepped
+    up by factors of at most 2 from M <= :data:`CONTINUATION_M` / 4, each step starting
+    from the previous pressure and film constant.
     """
     t0 = time.perf_counter()
     c = spec.contact()
@@ -164,7 +165,7 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
     # two-phase: sub-ambient pressures allowed down to absolute zero (gauge -p_ambient)
     p_floor = -P_AMBIENT_PA / c.p_hertz if twophase else 0.0
     prob = Problem(lam=c.lam, laws=spec.laws(), p_floor=p_floor, neumann_outlet=twophase,
-                   moes_M=c.M)
+                   moes_M=c.M, moes_L=c.L)
     solver = MultigridSolver(prob, dom, opt)
 
     def h0_guess(M: float) -> float:
@@ -175,20 +176,18 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
         prob = replace(prob, p_floor=0.0, laws=replace(prob.laws, twophase_p_scale=None))
         solver.prob = prob
     ramp: list[float] = []
-    direct = result = None
-    if c.M <= CONTINUATION_M:
-        direct = result = solver.solve(h0_guess(c.M))
-    if result is None or not result.converged:
+    direct = result = solver.solve(h0_guess(c.M))
+    if not result.converged:
         # a ramp by factors of 2 from M <= CONTINUATION_M / 4; if it blows up, a gentler one
         # (factors of sqrt 2 from M <= CONTINUATION_M / 8)
         for factor, start in ((2.0, CONTINUATION_M / 4), (math.sqrt(2.0), CONTINUATION_M / 8)):
             solver = MultigridSolver(prob, dom, opt)  # fresh: no state of a failed attempt
             ramp, attempt = _ramp(solver, prob, opt, c, factor, start, h0_guess)
-            if result is None or not _worse(attempt, result):
+            if not _worse(attempt, result):
                 result = attempt
             if attempt.converged:
                 break
-        if direct is not None and _worse(result, direct):
+        if _worse(result, direct):
             result, ramp = direct, []  # the ramp did not help: keep the direct attempt
     subambient = None
     if twophase and np.all(np.isfinite(result.P)):
