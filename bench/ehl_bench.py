@@ -1,16 +1,18 @@
-"""Cost and accuracy of the EHL solver against grid size (nominal case: 20 N, 10 mm/s, 40 C).
+"""Cost and accuracy of the EHL precalc against grid size (nominal case: 20 N, 10 mm/s, 40 C).
 
-    .venv/bin/python bench/ehl_bench.py [--max 2049] [--memory-only 4097]
-    .venv/bin/python bench/ehl_bench.py --full 4097
+    .venv/bin/python bench/ehl_bench.py [--max 4097] [--workers 1 2]
+    .venv/bin/python bench/ehl_bench.py --reuse
 
-For N = 129 .. --max points a side: wall time (numba compiled beforehand), cycles, peak
-memory of the process, hc; the observed order of convergence and the Richardson
-extrapolation from the three finest grids; hc error of each grid against that estimate; the
-cost ratio per grid doubling. ``--memory-only N`` also runs one grid of N points a side and
-reports its peak memory over three cycles (the thesis's scale is 4097). ``--full N`` solves
-only that grid to convergence and writes ehl_bench_full_N.json (its wall time, cycles, peak
-memory and hc). Otherwise writes
-bench/results/ehl_bench.json and ehl_cost_vs_error.png (wall time against hc error).
+For N = 257 .. --max points a side, each solve in a fresh process (numba compiled before
+the clock starts) on each thread count of --workers (the solver's one thread setting): wall
+and CPU time, cycles, peak memory of the process, hc; the observed order and the Richardson
+value of hc from the three finest grids, each grid's hc error against it, and the cost ratio
+per grid doubling (wall time, per thread count). The machine's load average is printed with
+each row: timings on a shared machine are noisy. Writes bench/results/ehl_bench.json.
+
+``--reuse`` times the nominal point on its default grid started from a neighbouring solution
+(another speed, temperature or load; ehlfoam.contact.solver.Start) against the full
+multigrid start, on one thread, and writes bench/results/ehl_bench_reuse.json.
 """
 
 from __future__ import annotations
@@ -19,85 +21,95 @@ import argparse
 import math
 import os
 
-from common import RESULTS, log, save, solve_in_subprocess
+from common import log, save, solve_in_subprocess
 
 NOMINAL = dict(load=20.0, speed=0.01, temperature=40.0)
+GRIDS = (257, 513, 1025, 2049, 4097)
+NEIGHBOURS = (dict(speed=0.0125), dict(speed=0.02), dict(temperature=35.0),
+              dict(temperature=25.0), dict(load=25.0), dict(load=30.0))
+
+
+def grid_table(grids: list[int], workers: list[int]) -> dict:
+    rows = []
+    log(f"cores: {os.cpu_count()}, load average now {os.getloadavg()}")
+    log(f"{'N':>6} {'threads':>7} {'wall [s]':>9} {'CPU [s]':>8} {'cycles':>6} {'peak [GiB]':>10} "
+        f"{'hc [nm]':>9} {'conv':>5} {'load avg':>9}")
+    for n in grids:
+        for w in workers:
+            s = solve_in_subprocess({**NOMINAL, "grid": n}, workers=w)
+            rows.append(dict(N=n, workers=w, wall_s=s["wall_s"], cpu_s=s["cpu_s"],
+                             cycles=s["cycles"], peak_GiB=s["peak_rss_GiB"],
+                             hc_nm=s["hc_m"] * 1e9, hmin_nm=s["hmin_m"] * 1e9,
+                             converged=s["converged"], load_average=s["load_average"]))
+            r = rows[-1]
+            log(f"{n:>6} {w:>7} {r['wall_s']:>9.1f} {r['cpu_s']:>8.1f} {r['cycles']:>6} "
+                f"{r['peak_GiB']:>10.2f} {r['hc_nm']:>9.4f} {r['converged']!s:>5} "
+                f"{r['load_average'][0]:>9.2f}")
+    out = {"case": NOMINAL, "rows": rows}
+    by_n = {r["N"]: r["hc_nm"] for r in rows}
+    ns = sorted(by_n)
+    if len(ns) >= 3:
+        h = [by_n[n] for n in ns[-3:]]
+        d1, d2 = h[1] - h[0], h[2] - h[1]
+        p = math.log2(abs(d1 / d2)) if d2 else float("nan")
+        extrap = h[2] + d2 / (2**p - 1)
+        out.update(observed_order=p, hc_richardson_nm=extrap)
+        log(f"observed order p = {p:.2f} (grids {ns[-3]}, {ns[-2]}, {ns[-1]}); Richardson hc = "
+            f"{extrap:.4f} nm")
+        log(f"{'N':>6} {'threads':>7} {'hc error':>9} {'wall ratio':>10} {'CPU ratio':>9}")
+        prev: dict[int, dict] = {}
+        for r in rows:
+            r["hc_error"] = abs(r["hc_nm"] - extrap) / extrap
+            last = prev.get(r["workers"])
+            r["wall_ratio_per_doubling"] = r["wall_s"] / last["wall_s"] if last else None
+            r["cpu_ratio_per_doubling"] = r["cpu_s"] / last["cpu_s"] if last else None
+            prev[r["workers"]] = r
+            wr = f"{r['wall_ratio_per_doubling']:.2f}" if last else "-"
+            cr = f"{r['cpu_ratio_per_doubling']:.2f}" if last else "-"
+            log(f"{r['N']:>6} {r['workers']:>7} {100 * r['hc_error']:>8.2f}% {wr:>10} {cr:>9}")
+    return out
+
+
+def reuse_table() -> dict:
+    """Neighbour start against the full multigrid start (one thread)."""
+    from ehlfoam.contact.solver import Start, solve
+    from ehlfoam.contact.spec import make_spec
+    import time
+
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+    solve(make_spec(grid=65, max_cycles=2))
+    target = make_spec(**NOMINAL)
+    c0 = time.process_time()
+    base = solve(target)
+    scratch = time.process_time() - c0
+    log(f"full multigrid start: {base.mg.cycles} cycles, {scratch:.1f} s CPU, "
+        f"hc {base.summary()['hc_m'] * 1e9:.4f} nm")
+    rows = []
+    for kw in NEIGHBOURS:
+        nb = solve(make_spec(**{**NOMINAL, **kw}))
+        c0 = time.process_time()
+        r = solve(target, start=Start.from_result(nb))
+        t = time.process_time() - c0
+        rows.append(dict(neighbour=kw, M_from=nb.contact.M, cycles=r.mg.cycles, cpu_s=t,
+                         ratio=t / scratch,
+                         hc_diff=r.summary()["hc_m"] / base.summary()["hc_m"] - 1.0))
+        log(f"from {kw} (M {nb.contact.M:.0f}): {r.mg.cycles} cycles, {t:.1f} s CPU = "
+            f"{t / scratch:.2f} x the FMG start, hc {100 * rows[-1]['hc_diff']:+.3f} %")
+    return dict(full_multigrid_cpu_s=scratch, full_multigrid_cycles=base.mg.cycles, rows=rows)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--max", type=int, default=2049)
-    ap.add_argument("--memory-only", type=int, default=None)
-    ap.add_argument("--full", type=int, default=None, help="time one full solve on N points")
+    ap.add_argument("--max", type=int, default=4097)
+    ap.add_argument("--min", type=int, default=257)
+    ap.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--reuse", action="store_true")
     args = ap.parse_args()
-    if args.full:
-        s = solve_in_subprocess({**NOMINAL, "grid": args.full})
-        row = dict(N=args.full, wall_s=s["wall_s"], cycles=s["cycles"], peak_GiB=s["peak_rss_GiB"],
-                   hc_nm=s["hc_m"] * 1e9, converged=s["converged"], residual=s.get("residual"),
-                   load_error=s.get("load_error"), ramp=bool(s["continuation_M"]),
-                   cores=os.cpu_count(), load_average=os.getloadavg())
-        log(f"N = {args.full}: {row['wall_s']:.0f} s, {row['cycles']} cycles, peak "
-            f"{row['peak_GiB']:.2f} GiB, hc = {row['hc_nm']:.4f} nm, converged={row['converged']}")
-        save(f"ehl_bench_full_{args.full}.json", {"case": NOMINAL, **row})
+    if args.reuse:
+        save("ehl_bench_reuse.json", reuse_table())
         return
-    grids = [n for n in (129, 257, 513, 1025, 2049, 4097) if n <= args.max]
-    rows = []
-    log(f"cores: {os.cpu_count()}")
-    log(f"{'N':>6} {'wall [s]':>9} {'cycles':>6} {'peak [GiB]':>10} {'hc [nm]':>9} "
-        f"{'converged':>9} {'ramp':>5}")
-    for n in grids:
-        s = solve_in_subprocess({**NOMINAL, "grid": n})
-        rows.append(dict(N=n, wall_s=s["wall_s"], cycles=s["cycles"], peak_GiB=s["peak_rss_GiB"],
-                         hc_nm=s["hc_m"] * 1e9, hmin_nm=s["hmin_m"] * 1e9,
-                         converged=s["converged"], ramp=bool(s["continuation_M"])))
-        r = rows[-1]
-        log(f"{n:>6} {r['wall_s']:>9.1f} {r['cycles']:>6} {r['peak_GiB']:>10.2f} "
-            f"{r['hc_nm']:>9.4f} {r['converged']!s:>9} {r['ramp']!s:>5}")
-    h = [r["hc_nm"] for r in rows]
-    out = {"case": NOMINAL, "rows": rows}
-    if len(h) >= 3:
-        d1, d2 = h[-2] - h[-3], h[-1] - h[-2]
-        p = math.log2(abs(d1 / d2)) if d2 else float("nan")
-        extrap = h[-1] + d2 / (2**p - 1)
-        out.update(observed_order=p, hc_extrapolated_nm=extrap)
-        log(f"observed order p = {p:.2f} (grids {rows[-3]['N']}, {rows[-2]['N']}, {rows[-1]['N']}); "
-            f"Richardson hc = {extrap:.4f} nm")
-        log(f"{'N':>6} {'hc error':>9} {'cost ratio':>10}")
-        for k, r in enumerate(rows):
-            r["hc_error"] = abs(r["hc_nm"] - extrap) / extrap
-            ratio = r["wall_s"] / rows[k - 1]["wall_s"] if k else float("nan")
-            r["cost_ratio_per_doubling"] = ratio
-            log(f"{r['N']:>6} {100 * r['hc_error']:>8.2f}% {ratio:>10.2f}")
-        within = [r["N"] for r in rows if r["hc_error"] <= 0.02]
-        log(f"coarsest grid within 2 % of the extrapolated hc: {min(within) if within else None}")
-        plot(rows)
-    if args.memory_only:
-        # the peak is reached in the first cycle: three cycles measure it without the full solve
-        s = solve_in_subprocess({**NOMINAL, "grid": args.memory_only, "max_cycles": 3})
-        out["memory_run"] = dict(N=args.memory_only, peak_GiB=s["peak_rss_GiB"], wall_s=s["wall_s"],
-                                 hc_nm=s["hc_m"] * 1e9, converged=s["converged"], cycles=s["cycles"])
-        log(f"N = {args.memory_only} (3 cycles): peak {s['peak_rss_GiB']:.2f} GiB, {s['wall_s']:.0f} s, "
-            f"hc = {s['hc_m'] * 1e9:.4f} nm, converged={s['converged']}")
-    save("ehl_bench.json", out)
-
-
-def plot(rows: list[dict]) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 4))
-    err = [max(r["hc_error"], 1e-5) for r in rows]
-    ax.loglog([r["wall_s"] for r in rows], err, "o-")
-    for r, e in zip(rows, err):
-        ax.annotate(f"{r['N']}", (r["wall_s"], e), textcoords="offset points", xytext=(5, 3))
-    ax.axhline(0.02, ls="--", c="gray", lw=0.8)
-    ax.set_xlabel("wall time on this machine [s]")
-    ax.set_ylabel("|hc - hc_Richardson| / hc_Richardson")
-    ax.set_title("EHL precalc: cost against error (nominal case)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(RESULTS / "ehl_cost_vs_error.png", dpi=120)
+    grids = [n for n in GRIDS if args.min <= n <= args.max]
+    save("ehl_bench.json", grid_table(grids, args.workers))
 
 
 if __name__ == "__main__":

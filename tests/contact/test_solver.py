@@ -199,7 +199,7 @@ def test_film_criterion_stops_at_the_converged_film(kw):
 
     spec = make_spec(**kw, grid=129)
     r = solve(spec)
-    tight = solve(spec, SolverOptions(tol_residual=1e-7, tol_load=1e-9, film_rel_max=0.0,
+    tight = solve(spec, SolverOptions(residual_only=1e-7, tol_load=1e-9, film_rel_max=0.0,
                                       film_rel_min=0.0, max_cycles=300))
     assert r.converged and tight.converged
     assert tight.mg.cycles > r.mg.cycles
@@ -230,6 +230,18 @@ def test_work_per_grid_doubling_does_not_grow():
     work = [solve(make_spec(**kw, grid=n)).mg.work_units for n in (129, 257, 513)]
     assert work[1] <= 1.1 * work[0] and work[2] <= 1.1 * work[1]
     assert work[2] < 60
+
+
+def test_start_from_a_neighbouring_solution():
+    """A solve started from another speed's solution (cycles only, no FMG) reaches the same
+    hc as the full multigrid start."""
+    from ehlfoam.contact.solver import Start
+
+    spec = make_spec(load=20, speed=0.05, temperature=40, grid=129)
+    nb = solve(make_spec(load=20, speed=0.04, temperature=40, grid=129))
+    r = solve(spec, start=Start.from_result(nb))
+    assert r.converged and r.mg.fmg_hc == []
+    assert r.summary()["hc_m"] == pytest.approx(solve(spec).summary()["hc_m"], rel=2e-3)
 
 
 def test_non_converging_run_is_reported():
