@@ -72,11 +72,18 @@ def grid_table(grids: list[int], workers: list[int]) -> dict:
 
 def reuse_table() -> dict:
     """Neighbour start against the full multigrid start (one thread)."""
-    from ehlfoam.contact.solver import Start, solve
-    from ehlfoam.contact.spec import make_spec
+    from ehlfoam.contact.multigrid import numba_threads
+
+    with numba_threads(1):
+        return _reuse_rows()
+
+
+def _reuse_rows() -> dict:
     import time
 
-    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+    from ehlfoam.contact.solver import Start, solve
+    from ehlfoam.contact.spec import make_spec
+
     solve(make_spec(grid=65, max_cycles=2))
     target = make_spec(**NOMINAL)
     c0 = time.process_time()
