@@ -10,8 +10,11 @@ zero-gradient outlet) and the film constant H0. Equations on every level:
 On the finest level f = 0, tauW = 0 and target = 2 pi / 3. The coarse levels carry the FAS
 right-hand sides (restricted residual plus coarse operator of the injected pressure), the
 FAS correction of the film (fine deformation minus coarse deformation of the injected
-pressure) and of the load. H0 is relaxed against the load on the coarsest level only.
-Full multigrid (FMG) start from a Hertzian pressure on the coarsest level.
+pressure) and of the load. H0 is relaxed against the load on the coarsest level, whose
+problem is solved (rounds of sweeps and H0 steps). Full multigrid (FMG) start from a
+Hertzian pressure on the coarsest level, each finer level cycled to its own discretisation
+error; the finest level until its film has settled (see :class:`SolverOptions`). Grid
+transfers: :mod:`ehlfoam.contact.transfer`.
 """
 
 from __future__ import annotations
@@ -28,6 +31,8 @@ from scipy.ndimage import minimum_filter
 from ehlfoam.contact.elastic import Deformation, hertz_pressure
 from ehlfoam.contact.lubricant import PressureLaws, coefficients, coefficients_parallel
 from ehlfoam.contact.reynolds import relax, relax_parallel, residual, residual_parallel
+from ehlfoam.contact.transfer import (prolong_bilinear, prolong_cubic, restrict_full_weighting,
+                                      restrict_pressure)
 
 LOAD_TARGET = 2.0 * math.pi / 3.0
 #: Grids with fewer points than this run on one thread (threads cost more than they save).
@@ -265,60 +270,6 @@ def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
         P[big] = P_old[big] + dP * (max_step / d_ln_eta[big])
 
 
-def _restrict_full_weighting(r: np.ndarray) -> np.ndarray:
-    rc = np.zeros(((r.shape[0] + 1) // 2, (r.shape[1] + 1) // 2))
-    rc[1:-1, 1:-1] = (
-        4.0 * r[2:-2:2, 2:-2:2]
-        + 2.0 * (r[2:-2:2, 1:-3:2] + r[2:-2:2, 3:-1:2] + r[1:-3:2, 2:-2:2] + r[3:-1:2, 2:-2:2])
-        + r[1:-3:2, 1:-3:2] + r[1:-3:2, 3:-1:2] + r[3:-1:2, 1:-3:2] + r[3:-1:2, 3:-1:2]
-    ) / 16.0
-    return rc
-
-
-def _restrict_pressure(P: np.ndarray, p_floor: float) -> np.ndarray:
-    """Coarse pressure: full weighting where the 3x3 fine neighbourhood is pressurised,
-    injection near the cavitation boundary and the domain boundary (keeps P >= 0 sharp)."""
-    Pc = P[::2, ::2].copy()
-    fw = _restrict_full_weighting(P)
-    allpos = minimum_filter(P > p_floor, size=3, mode="constant", cval=False)[::2, ::2]
-    allpos[[0, -1], :] = allpos[:, [0, -1]] = False
-    Pc[allpos] = fw[allpos]
-    return Pc
-
-
-def _cubic_midpoints(c: np.ndarray, axis: int) -> np.ndarray:
-    """Values halfway between the points of ``c`` along ``axis``: four-point (cubic)
-    interpolation, two-point next to the ends."""
-    c = np.moveaxis(c, axis, 0)
-    mid = 0.5 * (c[:-1] + c[1:])
-    if c.shape[0] >= 4:
-        mid[1:-1] = (9.0 * (c[1:-2] + c[2:-1]) - (c[:-3] + c[3:])) / 16.0
-    return np.moveaxis(mid, 0, axis)
-
-
-def _prolong_cubic(c: np.ndarray) -> np.ndarray:
-    """Fourth-order (cubic) interpolation to the next finer grid: the FMG interpolation of
-    the pressure (Venner & Lubrecht), whose O(h^4) error leaves the film's O(h^2)
-    discretisation error of the finer grid to the cycles."""
-    ny, nx = 2 * c.shape[0] - 1, 2 * c.shape[1] - 1
-    rows = np.empty((c.shape[0], nx))
-    rows[:, ::2] = c
-    rows[:, 1::2] = _cubic_midpoints(c, 1)
-    f = np.empty((ny, nx))
-    f[::2] = rows
-    f[1::2] = _cubic_midpoints(rows, 0)
-    return f
-
-
-def _prolong_bilinear(c: np.ndarray) -> np.ndarray:
-    ny, nx = 2 * c.shape[0] - 1, 2 * c.shape[1] - 1
-    f = np.zeros((ny, nx))
-    f[::2, ::2] = c
-    f[::2, 1::2] = 0.5 * (c[:, :-1] + c[:, 1:])
-    f[1::2, :] = 0.5 * (f[:-1:2, :] + f[2::2, :])
-    return f
-
-
 @dataclass
 class MGResult:
     """Converged (or not) finest-level solution and its convergence record."""
@@ -393,18 +344,18 @@ class MultigridSolver:
         for _ in range(opt.nu1):
             lv.relax(self.H0, prob, opt)
         r, _, H = lv.residual(lv.P, self.H0, prob)
-        P_hat = _restrict_pressure(lv.P, prob.p_floor)
+        P_hat = restrict_pressure(lv.P, prob.p_floor)
         co.P = P_hat.copy()
         # film FAS correction: the coarse film of P_hat is the fine film at the coarse points
         H_hat = H[::2, ::2]
         co.tauW = H_hat - self.H0 - co.rigid - co.deform(P_hat)
         zero_f = np.zeros_like(P_hat)
         r_hat, _, _ = co.residual(P_hat, self.H0, prob, f=zero_f, raw=True, H=H_hat)  # -L_H(P_hat)
-        co.f = -r_hat + _restrict_full_weighting(r)
+        co.f = -r_hat + restrict_full_weighting(r)
         co.load_target = lv.load_target + co.load(P_hat) - lv.load(lv.P)
         for _ in range(opt.gamma if k > 1 else 1):
             self._cycle(k - 1)
-        corr = _prolong_bilinear(co.P - P_hat)
+        corr = prolong_bilinear(co.P - P_hat)
         # no correction inside the cavitated region, nor on its boundary
         corr[~minimum_filter(lv.P > prob.p_floor, size=3, mode="constant", cval=False)] = 0.0
         P_before = lv.P.copy() if opt.limit_correction else None
@@ -467,7 +418,7 @@ class MultigridSolver:
         hc = [float(lv0.film(lv0.P, self.H0)[j, i])]
         for k in range(1, len(self.levels)):
             lv = self.levels[k]
-            lv.P = _prolong_cubic(self.levels[k - 1].P)
+            lv.P = prolong_cubic(self.levels[k - 1].P)
             lv.f[:] = 0.0
             lv.tauW[:] = 0.0
             lv.load_target = LOAD_TARGET
