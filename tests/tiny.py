@@ -3,7 +3,7 @@ precalc (the gap outside the island hardly depends on the film's last digits), 1
 from a puddle of 3 a around the contact. Builds in seconds, runs in seconds. And the numbers
 of a made-up case (:func:`tiny_geometry`) for code that only reads a case's geometry."""
 
-from ehlfoam.case.writer import CaseGeometry
+from ehlfoam.case.geometry import CaseGeometry
 
 SMALL = {
     "name": "test",
@@ -27,3 +27,23 @@ def tiny_geometry(**kw) -> CaseGeometry:
                 gap_mismatch=0.0, oil_viscosity=0.02, oil_density=870.0,
                 solver="interPhaseChangeFoam")
     return CaseGeometry(**(base | kw))
+
+
+def small_contact():
+    """The tiny case's spec, its gap h(x, y) [m] and its Hertzian radius a [m] (the precalc
+    solved once per machine, then reused)."""
+    from ehlfoam.gap.source import load_gap
+    from ehlfoam.spec.case import make_case_spec
+
+    spec = make_case_spec(SMALL)
+    return spec, load_gap(spec.contact)[0], spec.a
+
+
+def as_toml(spec: dict) -> str:
+    """A spec dict (scalars and one level of tables, as :data:`SMALL`) as TOML text."""
+    import json
+
+    top = [f"{k} = {json.dumps(v)}" for k, v in spec.items() if not isinstance(v, dict)]
+    tables = [f"[{k}]\n" + "\n".join(f"{kk} = {json.dumps(vv)}" for kk, vv in v.items())
+              for k, v in spec.items() if isinstance(v, dict)]
+    return "\n".join(top + tables) + "\n"

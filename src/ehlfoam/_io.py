@@ -17,8 +17,12 @@ from typing import IO, Any
 
 from ehlfoam.errors import SpecError
 
-__all__ = ["atomic_write", "atomic_write_json", "atomic_write_text", "finite_or_none",
-           "read_toml"]
+__all__ = ["MAX_SPEC_BYTES", "atomic_write", "atomic_write_json", "atomic_write_text",
+           "finite_or_none", "read_toml"]
+
+#: The largest spec file read [bytes]: a spec is a few kB (a mesh.refine band of 10,000
+#: points some 0.3 MB); a larger file is refused by its size, before it is read.
+MAX_SPEC_BYTES = 8 << 20
 
 
 def atomic_write(path: str | os.PathLike[str], write: Callable[[IO[bytes]], Any]) -> None:
@@ -56,11 +60,31 @@ def atomic_write_json(path: str | os.PathLike[str], data: Any) -> None:
 
 
 def read_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
-    """A TOML file as a dict; :class:`SpecError` naming the file if missing or malformed."""
+    """A TOML spec file as a dict; :class:`SpecError` naming the file and what is wrong if it
+    is missing, not a file, unreadable, larger than :data:`MAX_SPEC_BYTES`, not UTF-8 text
+    (a binary file) or not valid TOML."""
     path = Path(path)
+    name = f"spec file = {str(path)!r}"
     try:
-        return tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise SpecError(f"spec file = {str(path)!r}: no such file") from None
+        size = path.stat().st_size
+        if path.is_dir():
+            raise SpecError(f"{name}: is a folder, not a TOML file")
+        if size > MAX_SPEC_BYTES:
+            raise SpecError(f"{name}: {size / 1e6:.1f} MB is too large for a spec (at most "
+                            f"{MAX_SPEC_BYTES / 1e6:.1f} MB); is it the right file?")
+        data = path.read_bytes()
+    except OSError as err:
+        why = os.strerror(err.errno).lower() if err.errno else str(err)
+        raise SpecError(f"{name}: {why}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise SpecError(f"{name}: not a text file (byte {err.start} is not UTF-8): a TOML spec "
+                        f"is UTF-8 text") from None
+    if "\x00" in text:
+        raise SpecError(f"{name}: not a text file (it holds NUL bytes): a TOML spec is UTF-8 "
+                        f"text")
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise SpecError(f"spec file = {str(path)!r}: not valid TOML ({err})") from None
+        raise SpecError(f"{name}: not valid TOML ({err})") from None

@@ -19,7 +19,7 @@ from typing import Annotated, Any, get_args, get_origin
 from pydantic import BaseModel, Tag, ValidationError
 from pydantic.fields import FieldInfo
 
-__all__ = ["SpecError", "format_validation_error", "range_text", "unit_of"]
+__all__ = ["SpecError", "format_validation_error", "models_in", "range_text", "unit_of"]
 
 
 class SpecError(ValueError):
@@ -48,12 +48,12 @@ def unit_of(field: FieldInfo | None) -> str:
     return str(extra.get("unit", "")) if isinstance(extra, dict) else ""
 
 
-def _models_in(annotation: Any) -> list[type[BaseModel]]:
+def models_in(annotation: Any) -> list[type[BaseModel]]:
     """The model classes an annotation holds (itself, or inside a list, tuple, union,
     Annotated)."""
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
         return [annotation]
-    return [m for arg in get_args(annotation) for m in _models_in(arg)]
+    return [m for arg in get_args(annotation) for m in models_in(arg)]
 
 
 def _tags_in(annotation: Any) -> dict[str, type[BaseModel]]:
@@ -62,7 +62,7 @@ def _tags_in(annotation: Any) -> dict[str, type[BaseModel]]:
     if get_origin(annotation) is Annotated:
         inner, *meta = get_args(annotation)
         tags = [m.tag for m in meta if isinstance(m, Tag)]
-        models = _models_in(inner)
+        models = models_in(inner)
         if tags and len(models) == 1:
             out[tags[0]] = models[0]
     for arg in get_args(annotation):
@@ -85,9 +85,33 @@ def _walk(root: type[BaseModel], loc: tuple) -> tuple[str, type[BaseModel] | Non
             continue
         field = model.model_fields.get(str(part)) if model is not None else None
         name += f".{part}" if name else str(part)
-        inner = _models_in(field.annotation) if field is not None else []
+        inner = models_in(field.annotation) if field is not None else []
         model = inner[0] if len(inner) == 1 else None
     return name, model, field
+
+
+def _as_written(value: Any) -> Any:
+    """A value as the user wrote it: tuples (a strict model's arrays) as lists."""
+    if isinstance(value, (tuple, list)):
+        return [_as_written(v) for v in value]
+    return value
+
+
+def _strict_text(error: Mapping[str, Any]) -> str | None:
+    """What a strict type error means, where pydantic's words do not say it: a boolean or a
+    string given for a number, a fraction for an integer."""
+    given, kind = error.get("input"), error.get("type")
+    if kind not in ("float_type", "int_type", "int_from_float"):
+        return None
+    wanted = "a number" if kind == "float_type" else "an integer"
+    if isinstance(given, bool):
+        return f"a boolean is not {wanted} (types are strict)"
+    if isinstance(given, str):
+        return f"a string is not {wanted} (types are strict: write it without quotes)"
+    if isinstance(given, float) and kind != "float_type":
+        return f"{given!r} is not an integer (write {int(given)})" \
+            if given.is_integer() else f"{given!r} is not an integer"
+    return None
 
 
 def format_validation_error(err: ValidationError, root: type[BaseModel], *,
@@ -109,7 +133,7 @@ def format_validation_error(err: ValidationError, root: type[BaseModel], *,
         name, _, field = _walk(root, loc)
         name = name or "spec"
         last = str(loc[-1]) if loc else ""
-        msg = e["msg"].removeprefix("Value error, ")
+        msg = _strict_text(e) or e["msg"].removeprefix("Value error, ")
         if e["type"] == "extra_forbidden":
             holder = _walk(root, loc[:-1])[1]
             valid = ", ".join(holder.model_fields) if holder is not None else ""
@@ -118,7 +142,7 @@ def format_validation_error(err: ValidationError, root: type[BaseModel], *,
             clauses.append(f"{name}: missing" + (f": {hints[last]}" if last in hints else ""))
         elif loc and "input" in e and not isinstance(e["input"], dict):
             rng = range_text(name, field, unit_of(field) or units.get(last, "")) if field else ""
-            clauses.append(f"{name} = {e['input']!r}: {msg}" + (f" ({rng})" if rng else ""))
+            clauses.append(f"{name} = {_as_written(e['input'])!r}: {msg}" + (f" ({rng})" if rng else ""))
         else:
             clauses.append(f"{name}: {msg}" if loc else msg)
     return "; ".join(clauses)

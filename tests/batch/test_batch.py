@@ -23,15 +23,17 @@ import pytest
 from foamlib import FoamFieldFile
 
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from ehlfoam.cli import batch as batch_cli
 from ehlfoam.run import fields as case_fields
 from ehlfoam.batch.launch import BatchError, BatchOptions, run_batch
 from ehlfoam.batch.executors import parse_slurm, slurm_cluster
 from ehlfoam.batch.folder import CASES
 from ehlfoam.batch.results import FIXED_COLUMNS, read_results
+from ehlfoam.metrics.record import SCHEMA_VERSION, MetricsRecord, read_metrics
 from ehlfoam.run.fields import time_folders
-from ehlfoam.seed.start import seed_from_previous
+from ehlfoam.seed.previous import seed_from_previous
 
 ROOT = Path(__file__).resolve().parents[2]
 BATCH = [sys.executable, "-m", "ehlfoam.cli.batch"]
@@ -51,12 +53,12 @@ SMALL = tomllib.loads(BASE)["base"]
 #: build failure), and a ramp 10 -> 20 -> 10 mm/s
 TINY = BASE + """
 [[sweep]]
-speed_mm_s = [10, 20]
+contact.speed = [0.01, 0.02]
 [[sweep]]
-speed_mm_s = [0.5]
+contact.speed = [0.0005]
 [[ramp]]
 name = "A"
-speed_mm_s = [10, 20]
+contact.speed = [0.01, 0.02]
 """
 FAILING = "u00.5_s3um_T40_F20_coarse"
 RAMP = ["rampA_up01_u10.0_s3um_T40_F20_coarse", "rampA_up02_u20.0_s3um_T40_F20_coarse",
@@ -84,13 +86,14 @@ def tiny(tmp_path_factory):
 
 # ------------------------------------------------------------------ bad input
 @pytest.mark.parametrize("body, expected", [
-    (BASE + "[sweep]\nspeed_mm_s = [10]\nspeeds = [5]\n", "sweep.speeds: unknown key"),
-    (BASE + "[sweep]\nspeed_mm_s = []\n", "sweep.speed_mm_s = []: empty sweep"),
-    (BASE + "[sweep]\nspeed_mm_s = [10, -5]\n",
-     "sweep.speed_mm_s = -5 mm/s gives an invalid case: contact.speed = -0.005: Input should "
-     "be greater than 0 (valid range 0 < contact.speed <= 100)"),
-    (BASE + "[[ramp]]\nname = \"A\"\n", "ramp[0].speed_mm_s: missing: a ramp needs its speeds"),
-    (BASE + "[[ramp]]\nname = \"A\"\nspeed_mm_s = []\n", "a ramp without speeds"),
+    (BASE + "[sweep]\ncontact.speed = [0.01]\nspeeds = [5]\n", "sweep: speeds: unknown key"),
+    (BASE + "[sweep]\ncontact.speed = []\n", "sweep.contact.speed = []: empty sweep"),
+    (BASE + "[sweep]\ncontact.speed = [0.01, -0.005]\n",
+     "sweep: contact.speed = -0.005: Input should be greater than 0 (valid range 0 < "
+     "contact.speed <= 100 m/s)"),
+    (BASE + "[[ramp]]\nname = \"A\"\n",
+     "ramp[0].contact.speed: missing: a ramp needs its speeds"),
+    (BASE + "[[ramp]]\nname = \"A\"\ncontact.speed = []\n", "a ramp without speeds"),
 ])
 def test_bad_batch_spec_fails_before_anything_is_built(tmp_path, capsys, body, expected):
     spec = _spec(tmp_path, "bad", body)
@@ -102,10 +105,17 @@ def test_bad_batch_spec_fails_before_anything_is_built(tmp_path, capsys, body, e
 
 
 def test_bad_spec_exit_code_from_the_command(tmp_path):
-    spec = _spec(tmp_path, "bad", BASE + "[sweep]\nspeed_mm_s = [10]\nload = [5]\n")
+    spec = _spec(tmp_path, "bad", BASE + "[sweep]\ncontact.speed = [0.01]\nload = [5]\n")
     proc = subprocess.run([*BATCH, str(spec)], capture_output=True, text=True, cwd=spec.parent)
-    assert proc.returncode == 2 and "sweep.load: unknown key" in proc.stderr
+    assert proc.returncode == 2 and "sweep: load: unknown key" in proc.stderr
     assert not (tmp_path / "bad").exists() and not (tmp_path / "runs").exists()
+
+
+def test_report_option_takes_the_reporting_function():
+    """The batch sits below the reports: it takes the function that makes its report."""
+    with pytest.raises(TypeError, match="ehlfoam.report.after_batch"):
+        BatchOptions(report=True)
+    assert BatchOptions().report is None and BatchOptions(report=False).report is False
 
 
 def test_parser_registration_and_dry_run(tmp_path, capsys):
@@ -123,6 +133,7 @@ def test_parser_registration_and_dry_run(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------ a local batch
+@pytest.mark.openfoam
 def test_batch_layout_and_results(tiny):
     spec, outcome = tiny
     batch = outcome.batch_dir
@@ -133,19 +144,26 @@ def test_batch_layout_and_results(tiny):
     plan = json.loads((batch / "plan.json").read_text())
     assert [p["id"] for p in plan] == ["u10.0_s3um_T40_F20_coarse", "u20.0_s3um_T40_F20_coarse",
                                        FAILING, *RAMP]
-    assert plan[0]["params"] == {"speed_mm_s": 10.0, "temperature_C": 40.0, "load_N": 20.0,
-                                 "supply": "layers", "disc_layer_um": 3.0, "ball_layer_um": 3.0,
-                                 "resolution": "coarse"}
+    assert plan[0]["params"] == {"contact.speed": 0.01, "contact.temperature": 40.0,
+                                 "contact.load": 20.0, "supply.mode": "layers",
+                                 "supply.disc_layer": 3e-6, "supply.ball_layer": 3e-6,
+                                 "mesh.resolution": "coarse"}
     assert plan[0]["ramp"] is None
     assert plan[5]["ramp"] == {"name": "A", "step": 3, "direction": "down", "previous": RAMP[1]}
     with open(batch / "results.csv", newline="") as fh:
         reader = csv.DictReader(fh)
         assert tuple(reader.fieldnames[:len(FIXED_COLUMNS)]) == FIXED_COLUMNS
         assert "oil_volume_m3" in reader.fieldnames and "time_steps" in reader.fieldnames
+        # every metrics column is a key of the metrics record
+        assert set(reader.fieldnames[len(FIXED_COLUMNS):]) <= set(MetricsRecord.model_fields)
         rows = {r["case_id"]: r for r in reader}
     assert list(rows) == [p["id"] for p in plan]
     ok = rows["u10.0_s3um_T40_F20_coarse"]
     assert ok["status"] == "finished" and ok["end_reason"] == "end_time"
+    assert float(ok["contact.speed"]) == 0.01 and ok["supply.mode"] == "layers"
+    m = read_metrics(batch / ok["case_dir"])
+    assert m.schema_version == SCHEMA_VERSION and m.case_id == ok["case_id"]
+    assert float(ok["oil_volume_m3"]) == m.oil_volume_m3 and not m.model_extra
     assert ok["state"] in ("I", "II") and float(ok["wall_s"]) > 0 and int(ok["cells"]) > 0
     assert (batch / ok["case_dir"] / "metrics.json").is_file() and (batch / ok["log"]).is_file()
     bad = rows[FAILING]
@@ -153,10 +171,11 @@ def test_batch_layout_and_results(tiny):
     assert (batch / bad["case_dir"] / "error.log").is_file()
     assert rows[RAMP[2]]["ramp"] == "A" and rows[RAMP[2]]["ramp_direction"] == "down"
     regime = json.loads((batch / "regime" / "regime.json").read_text())
-    assert regime["ramps"][0]["name"] == "A" and regime["figures"]
-    assert all((batch / f).is_file() for f in regime["figures"])
+    assert regime["ramps"][0]["name"] == "A"
+    assert regime["ramps"][0]["up"]["contact.speed"] == [0.01, 0.02]
 
 
+@pytest.mark.openfoam
 def test_ramp_step_starts_from_the_previous_final_fields(tiny):
     batch = tiny[1].batch_dir / CASES
     down, up = batch / RAMP[2], batch / RAMP[1]
@@ -181,6 +200,7 @@ def test_ramp_step_starts_from_the_previous_final_fields(tiny):
     assert first["oil_volume_m3"] == fresh["oil_volume_m3"]
 
 
+@pytest.mark.openfoam
 def test_ramp_start_on_another_mesh_is_interpolated(tiny, tmp_path):
     previous = tiny[1].batch_dir / CASES / RAMP[1]
     case = tmp_path / "finer"
@@ -192,18 +212,19 @@ def test_ramp_start_on_another_mesh_is_interpolated(tiny, tmp_path):
     structure = case_fields.Structure.load(case)
     seeded = case_fields.initial_oil_volume(case, structure, load_geometry(case))
     final = json.loads((previous / "metrics.json").read_text())["oil_volume_m3"]
-    # interpolated, then put back to the previous case's oil volume (runs/field_mapping.py)
+    # interpolated, then put back to the previous case's oil volume (ehlfoam.seed.mapping)
     assert info["oil"]["conserved"] and info["oil"]["interpolated_m3"] != pytest.approx(
         info["oil"]["source_m3"], rel=1e-6, abs=0)
     assert seeded == pytest.approx(final, rel=1e-6, abs=0)
 
 
+@pytest.mark.openfoam
 def test_ramp_starts_from_a_run_case(tiny, tmp_path, capsys):
     """``start_from``: the ramp's first step starts from a case that ran elsewhere (here a
     finished step of the tiny batch), not from the puddle; a folder that has not run is
     refused before anything is built."""
     source = tiny[1].batch_dir / CASES / RAMP[1]
-    ramp = "[[ramp]]\nname = \"S\"\nspeed_mm_s = [15, 25]\nbranches = \"up\"\n"
+    ramp = "[[ramp]]\nname = \"S\"\ncontact.speed = [0.015, 0.025]\nbranches = \"up\"\n"
     bad = _spec(tmp_path, "bad", BASE + ramp + f"start_from = \"{tmp_path}\"\n")
     assert batch_cli.main([str(bad), "--quiet"]) == 2
     err = capsys.readouterr().err
@@ -221,6 +242,7 @@ def test_ramp_starts_from_a_run_case(tiny, tmp_path, capsys):
         json.loads((source / "metrics.json").read_text())["oil_volume_m3"], rel=1e-3, abs=0)
 
 
+@pytest.mark.openfoam
 def test_ramp_steps_with_mesh_follow_follow_the_meniscus_they_start_from(tiny, tmp_path):
     """With ``mesh.follow`` every ramp step's mesh has bands along the meniscus of what it
     starts from (start_from, then the step before), and its written spec keeps them."""
@@ -228,7 +250,7 @@ def test_ramp_steps_with_mesh_follow_follow_the_meniscus_they_start_from(tiny, t
     base = BASE.replace("wall_grading = 3.0 }",
                         "wall_grading = 3.0, follow = { half_width = 0.5 } }")
     assert base != BASE
-    ramp = "[[ramp]]\nname = \"F\"\nspeed_mm_s = [15, 25]\nbranches = \"up\"\n"
+    ramp = "[[ramp]]\nname = \"F\"\ncontact.speed = [0.015, 0.025]\nbranches = \"up\"\n"
     spec = _spec(tmp_path, "follow", base + ramp + f"start_from = \"{source}\"\n")
     outcome = run_batch(spec, BatchOptions(out=spec.with_suffix(""), jobs=1, quiet=True, report=False))
     assert outcome.exit_code == 0
@@ -242,6 +264,7 @@ def test_ramp_steps_with_mesh_follow_follow_the_meniscus_they_start_from(tiny, t
         assert json.loads((case / "metrics.json").read_text())["status"] == "finished"
 
 
+@pytest.mark.openfoam
 def test_rerun_keeps_finished_and_failed_cases(tiny):
     spec, outcome = tiny
     before = _mtimes(outcome.batch_dir)
@@ -260,7 +283,8 @@ def test_rerun_keeps_finished_and_failed_cases(tiny):
 
 def test_failed_ramp_step_leaves_the_later_steps_pending(tmp_path):
     """A ramp whose first step cannot be built (0.5 mm/s: the precalc does not converge)."""
-    spec = _spec(tmp_path, "ramp", BASE + "[[ramp]]\nname = \"B\"\nspeed_mm_s = [0.5, 10]\n")
+    spec = _spec(tmp_path, "ramp",
+                 BASE + "[[ramp]]\nname = \"B\"\ncontact.speed = [0.0005, 0.01]\n")
     outcome = run_batch(spec, BatchOptions(out=spec.with_suffix(""), jobs=2, quiet=True, report=False))
     assert outcome.exit_code == 1 and outcome.ran == ["rampB_up01_u00.5_s3um_T40_F20_coarse"]
     rows = read_results(outcome.batch_dir)
@@ -273,6 +297,7 @@ def test_failed_ramp_step_leaves_the_later_steps_pending(tmp_path):
         ["failed", "pending", "pending"]
 
 
+@pytest.mark.openfoam
 def test_finished_case_with_another_spec_is_refused(tiny, tmp_path):
     spec, outcome = tiny
     changed = _spec(tmp_path, "tiny", spec.read_text().replace("end_time = 1e-3",
@@ -285,6 +310,7 @@ def test_finished_case_with_another_spec_is_refused(tiny, tmp_path):
 
 
 # ------------------------------------------------------------------ the Dask path
+@pytest.mark.slow
 def test_dask_local_cluster_gives_the_same_results(tiny, tmp_path):
     from distributed import Client, LocalCluster
 
@@ -329,8 +355,9 @@ def test_slurm_cluster_is_configured_for_mpi_cases():
 KILL = BASE.replace("end_time = 1e-3, writes_per_transit = 1000",
                     "end_time = 2e-2, writes_per_transit = 100") + """
 [sweep]
-speed_mm_s = [10, 20]
-supply = [2, 3, 4]
+contact.speed = [0.01, 0.02]
+supply = [{disc_layer = 2e-6, ball_layer = 2e-6}, {disc_layer = 3e-6, ball_layer = 3e-6},
+          {disc_layer = 4e-6, ball_layer = 4e-6}]
 """
 
 
@@ -390,6 +417,7 @@ def _gone(pids: list[int], batch: Path, timeout: float = 60.0) -> bool:
     return False
 
 
+@pytest.mark.openfoam
 def test_interrupt_kill_and_resume(tmp_path):
     """Ctrl-C, then SIGKILL of the batch process, each after a case finished; the re-runs
     never recompute a finished case and results.csv keeps one row per case."""

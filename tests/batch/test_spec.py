@@ -7,7 +7,8 @@ from pathlib import Path
 import pytest
 
 from ehlfoam.errors import SpecError
-from ehlfoam.batch.spec import expand, load_plan, parse_batch_spec
+from ehlfoam.batch.plan import expand, load_plan
+from ehlfoam.batch.spec import parse_batch_spec
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -17,33 +18,51 @@ def _plan(data: dict):
 
 
 @pytest.mark.parametrize("data, expected", [
-    ({"sweep": {"speed_mm_s": [5], "sped": [1]}},
-     ["sweep.sped: unknown key", "valid here: speed_mm_s, temperature_C"]),
-    ({"sweeps": {"speed_mm_s": [5]}}, ["sweeps: unknown key", "sweep, ramp"]),
-    ({"sweep": {"speed_mm_s": []}}, ["sweep.speed_mm_s = []: empty sweep"]),
+    ({"sweep": {"contact": {"speed": [0.005], "sped": [1]}}},
+     ["sweep: contact.sped: unknown key", "valid here: ", "speed"]),
+    ({"sweep": {"speeds": [0.005]}}, ["sweep: speeds: unknown key", "contact, supply"]),
+    ({"sweeps": {"contact.speed": [0.005]}}, ["sweeps: unknown key", "sweep, ramp"]),
+    ({"sweep": {"contact.speed": []}}, ["sweep.contact.speed = []: empty sweep"]),
+    ({"sweep": {"contact": {"speed": []}}}, ["sweep.contact.speed = []: empty sweep"]),
+    ({"sweep": {"contact.speed": [0.005], "contact": {"speed": [0.008]}}},
+     ["contact.speed is given twice"]),
     ({"sweep": {}}, ["empty sweep (sweep[0] has no values)"]),
+    ({"sweep": {"name": ["a", "b"]}}, ["the case name is the case id"]),
     ({}, ["the batch has no cases"]),
-    ({"sweep": {"speed_mm_s": {"start": 5, "stop": 25, "num": 0}}}, ["empty sweep"]),
-    ({"sweep": {"speed_mm_s": [-5, 8]}},
-     ["sweep.speed_mm_s = -5 mm/s", "contact.speed = -0.005",
-      "valid range 0 < contact.speed <= 100"]),
-    ({"ramp": [{"name": "A"}]}, ["ramp[0].speed_mm_s: missing: a ramp needs its speeds"]),
-    ({"base": {"mesh": {"follow": {}}}, "sweep": {"speed_mm_s": [5]}},
-     ["case u05.0_flooded", "has mesh.follow but no state to start from", "only a ramp's steps"]),
-    ({"base": {"mesh": {"follow": {}}}, "ramp": [{"name": "A", "speed_mm_s": [5, 8]}]},
+    ({"sweep": {"contact.speed": {"start": 0.005, "stop": 0.025, "num": 0}}}, ["empty sweep"]),
+    ({"sweep": {"contact.speed": [-0.005, 0.008]}},
+     ["sweep: contact.speed = -0.005", "valid range 0 < contact.speed <= 100"]),
+    ({"sweep": [{"contact.speed": [0.005]}, {"contact.load": [0.0]}]},
+     ["sweep[1]: contact.load = 0.0", "valid range 0 < contact.load"]),
+    ({"ramp": [{"name": "A"}]}, ["ramp[0].contact.speed: missing: a ramp needs its speeds"]),
+    ({"base": {"mesh": {"follow": {}}}, "sweep": {"contact.speed": [0.005]}},
+     ["case u05.0_flooded", "has mesh.follow but no state to start from", "only a ramp's"]),
+    ({"base": {"mesh": {"follow": {}}}, "ramp": [{"name": "A", "contact.speed": [0.005, 0.008]}]},
      ["case rampA_up01_u05.0", "has mesh.follow but no state to start from"]),
-    ({"ramp": [{"name": "A", "speed_mm_s": []}]}, ["a ramp without speeds"]),
-    ({"ramp": [{"name": "A", "speed_mm_s": [8, 5]}]}, ["strictly increasing"]),
-    ({"ramp": [{"name": "A", "speed_mm_s": [5, 8]}, {"name": "A", "speed_mm_s": [5, 8]}]},
+    ({"ramp": [{"name": "A", "contact.speed": []}]}, ["a ramp without speeds"]),
+    ({"ramp": [{"name": "A", "contact.speed": [0.008, 0.005]}]}, ["strictly increasing"]),
+    ({"ramp": [{"name": "A", "contact": {"speed": [0.005, 0.008], "temperature": 99}}]},
+     ["ramp 'A': contact: temperature = 99 C", "valid range 25 to 60 C"]),
+    ({"ramp": [{"name": "A", "contact.speed": [0.005, 0.008]},
+               {"name": "A", "contact.speed": [0.005, 0.008]}]},
      ["ramp name = 'A' is used twice"]),
-    ({"sweep": {"temperature_C": [99]}},
-     ["sweep.temperature_C = 99 C", "valid range 25 to 60 C"]),
-    ({"sweep": {"supply": ["dry"]}}, ["supply item 'dry'", "flooded"]),
-    ({"sweep": {"supply": [-1]}}, ["supply.disc_layer = -1e-06", "valid range 0 <= "]),
-    ({"sweep": {"resolution": ["ultra"]}}, ["mesh.resolution = 'ultra'", "'coarse'"]),
-    ({"base": {"mesh": {"levels": 3}}, "sweep": {"speed_mm_s": [5]}},
+    ({"sweep": {"contact.temperature": [99]}},
+     ["sweep: contact: temperature = 99 C", "valid range 25 to 60 C"]),
+    ({"sweep": {"supply": [{"mode": "dry"}]}}, ["sweep.supply[0]: supply.mode = 'dry'",
+                                                "'flooded'"]),
+    ({"sweep": {"supply": [{"disc_layer": -1e-6}]}},
+     ["sweep.supply[0]: supply.disc_layer = -1e-06", "valid range 0 <= "]),
+    ({"sweep": {"mesh.resolution": ["ultra"]}}, ["mesh.resolution = 'ultra'", "'coarse'"]),
+    ({"base": {"mesh": {"levels": 3}}, "sweep": {"contact.speed": [0.005]}},
      ["base: invalid case spec: mesh.levels: unknown key"]),
-    ({"sweep": {"speed_mm_s": {"start": 5, "stop": 25}}}, ["a range needs start, stop"]),
+    ({"sweep": {"contact.speed": {"start": 0.005, "stop": 0.025}}},
+     ["a range needs start, stop"]),
+    ({"sweep": {"speed_mm_s": [5, 8]}},
+     ["speed_mm_s = [5, 8]: the batch spec takes the case spec's keys in SI: give "
+      "contact.speed in m/s"]),
+    ({"sweep": {"supply": [1, "flooded"]}}, ["supply = [1, 'flooded']: supply takes supply "
+                                             "tables"]),
+    ({"ramp": [{"name": "A", "speed_mm_s": [5, 8]}]}, ["give contact.speed in m/s"]),
 ])
 def test_bad_specs_name_key_value_and_range(data, expected):
     with pytest.raises(SpecError) as err:
@@ -53,42 +72,66 @@ def test_bad_specs_name_key_value_and_range(data, expected):
 
 
 def test_ranges_lists_and_scalars():
-    plan = _plan({"sweep": {"speed_mm_s": {"start": 5, "stop": 25, "step": 5},
-                            "load_N": {"start": 5, "stop": 20, "num": 3, "spacing": "log"},
-                            "temperature_C": 40}})
-    speeds = sorted({pc.params["speed_mm_s"] for pc in plan})
-    loads = sorted({pc.params["load_N"] for pc in plan})
-    assert speeds == [5, 10, 15, 20, 25]
+    plan = _plan({"sweep": {"contact": {
+        "speed": {"start": 0.005, "stop": 0.025, "step": 0.005},
+        "load": {"start": 5, "stop": 20, "num": 3, "spacing": "log"}, "temperature": 40}}})
+    speeds = sorted({pc.params["contact.speed"] for pc in plan})
+    loads = sorted({pc.params["contact.load"] for pc in plan})
+    assert speeds == [0.005, 0.01, 0.015, 0.02, 0.025]
     assert loads == pytest.approx([5, 10, 20])
-    assert len(plan) == 15 and {pc.params["temperature_C"] for pc in plan} == {40.0}
+    assert len(plan) == 15 and {pc.params["contact.temperature"] for pc in plan} == {40.0}
+    assert [pc.id for pc in plan[:2]] == ["u05.0_flooded_T40_F5_medium",
+                                          "u05.0_flooded_T40_F10_medium"]
 
 
 def test_ids_params_and_si_specs():
     plan = _plan({"base": {"mesh": {"resolution": "coarse"}},
-                  "sweep": {"speed_mm_s": [8, 8.25], "supply": [2, "flooded",
-                                                                {"disc_um": 1, "ball_um": 3},
-                                                                "submerged"]}})
+                  "sweep": {"contact.speed": [0.008, 0.00825],
+                            "supply": [{"disc_layer": 2e-6, "ball_layer": 2e-6},
+                                       {"mode": "flooded"},
+                                       {"disc_layer": 1e-6, "ball_layer": 3e-6},
+                                       {"mode": "submerged"}]}})
     ids = [pc.id for pc in plan]
     assert ids[:4] == ["u08.0_s2um_T40_F20_coarse", "u08.0_flooded_T40_F20_coarse",
                        "u08.0_s1+3um_T40_F20_coarse", "u08.0_submerged_T40_F20_coarse"]
     assert "u08.25_s2um_T40_F20_coarse" in ids and len(set(ids)) == len(ids) == 8
     pc = plan[0]
-    assert pc.params == {"speed_mm_s": 8.0, "temperature_C": 40.0, "load_N": 20.0,
-                         "supply": "layers", "disc_layer_um": 2.0, "ball_layer_um": 2.0,
-                         "resolution": "coarse"}
-    assert pc.spec.speed == pytest.approx(0.008)
-    assert pc.spec.supply.disc_layer == pytest.approx(2e-6)
+    assert pc.params == {"contact.speed": 0.008, "contact.temperature": 40.0,
+                         "contact.load": 20.0, "supply.mode": "layers",
+                         "supply.disc_layer": 2e-6, "supply.ball_layer": 2e-6,
+                         "mesh.resolution": "coarse"}
+    assert pc.spec.speed == 0.008 and pc.spec.supply.mode == "layers"    # layers: mode layers
+    assert pc.spec.supply.disc_layer == 2e-6
     assert pc.spec.name == pc.id and pc.ramp is None
     flooded = plan[1]
-    assert flooded.spec.supply.mode == "flooded" and flooded.params["disc_layer_um"] is None
+    assert flooded.spec.supply.mode == "flooded" and flooded.params["supply.disc_layer"] is None
     assert plan[3].spec.supply.mode == "submerged" and plan[3].spec.fills_domain
     assert pc.to_json() == {"id": pc.id, "params": pc.params, "ramp": None}
 
 
+def test_supply_tables_keep_the_base_supply_keys():
+    plan = _plan({"base": {"supply": {"mode": "layers", "track_half_width": 2e-4}},
+                  "sweep": {"supply": [{"disc_layer": 1e-6, "ball_layer": 1e-6}]}})
+    assert plan[0].spec.supply.track_half_width == 2e-4 and plan[0].id.startswith("u08.0_s1um")
+
+
+def test_any_case_spec_key_can_be_swept_and_names_its_cases():
+    plan = _plan({"base": {"mesh": {"resolution": "coarse"}},
+                  "sweep": {"contact.speed": [0.008],
+                            "physics": {"contact_angle": [15.0, 43.0]}}})
+    assert [pc.id for pc in plan] == ["u08.0_flooded_T40_F20_coarse_contact_angle15",
+                                      "u08.0_flooded_T40_F20_coarse_contact_angle43"]
+    assert [pc.spec.physics.contact_angle for pc in plan] == [15.0, 43.0]
+    assert plan[1].params["physics.contact_angle"] == 43.0
+    with pytest.raises(SpecError, match="physics.contact_angle = 200.0"):
+        _plan({"sweep": {"physics.contact_angle": [200.0]}})
+
+
 def test_sweeps_union_and_unswept_values_from_the_base():
     plan = _plan({"base": {"contact": {"temperature": 25.0, "speed": 0.012}},
-                  "sweep": [{"speed_mm_s": [8, 12]}, {"speed_mm_s": [12], "load_N": [30]},
-                            {"speed_mm_s": [8]}]})
+                  "sweep": [{"contact.speed": [0.008, 0.012]},
+                            {"contact": {"speed": [0.012], "load": [30]}},
+                            {"contact.speed": [0.008]}]})
     # the case spec's default supply is flooded, its default level medium
     assert [pc.id for pc in plan] == ["u08.0_flooded_T25_F20_medium",
                                       "u12.0_flooded_T25_F20_medium",
@@ -97,8 +140,10 @@ def test_sweeps_union_and_unswept_values_from_the_base():
 
 def test_ramp_steps_up_then_down():
     plan = _plan({"base": {"mesh": {"resolution": "coarse"}},
-                  "ramp": [{"name": "A", "speed_mm_s": [5, 8, 12], "supply": 1.5},
-                           {"name": "B", "speed_mm_s": [5, 8], "branches": "down-up"}]})
+                  "ramp": [{"name": "A", "contact.speed": [0.005, 0.008, 0.012],
+                            "supply": {"disc_layer": 1.5e-6, "ball_layer": 1.5e-6}},
+                           {"name": "B", "contact": {"speed": [0.005, 0.008]},
+                            "branches": "down-up"}]})
     a = [pc for pc in plan if pc.ramp["name"] == "A"]
     assert [pc.id for pc in a] == [
         "rampA_up01_u05.0_s1.5um_T40_F20_coarse", "rampA_up02_u08.0_s1.5um_T40_F20_coarse",
@@ -107,31 +152,47 @@ def test_ramp_steps_up_then_down():
     assert a[0].ramp == {"name": "A", "step": 1, "direction": "up", "previous": None}
     assert all(pc.ramp["previous"] == prev.id for prev, pc in zip(a, a[1:]))
     b = [pc for pc in plan if pc.ramp["name"] == "B"]
-    assert [(pc.params["speed_mm_s"], pc.ramp["direction"]) for pc in b] == [
-        (8.0, "down"), (5.0, "down"), (8.0, "up")]
+    assert [(pc.params["contact.speed"], pc.ramp["direction"]) for pc in b] == [
+        (0.008, "down"), (0.005, "down"), (0.008, "up")]
 
 
 @pytest.mark.parametrize("name, n_cases", [("default", 5), ("regime", 34)])
 def test_shipped_batch_specs_expand(name, n_cases):
     batch, plan = load_plan(ROOT / "examples" / "batches" / f"{name}.toml")
     assert batch.name == name and len(plan) == n_cases
-    at_ref = [pc for pc in plan if pc.params["temperature_C"] == 40 and pc.params["load_N"] == 20]
+    at_ref = [pc for pc in plan
+              if pc.params["contact.temperature"] == 40 and pc.params["contact.load"] == 20]
     assert len(at_ref) >= 5 and all(pc.spec.mesh.resolution == "coarse" for pc in plan)
     if name == "default":
-        assert {pc.params["speed_mm_s"] for pc in plan} >= {8.0, 17.0}
+        assert {pc.params["contact.speed"] for pc in plan} >= {0.008, 0.017}
         assert all(pc.ramp is None for pc in plan)
     else:
         sweep = [pc for pc in at_ref if pc.ramp is None]
-        assert len({pc.params["speed_mm_s"] for pc in sweep}) >= 5
-        assert len({pc.params["disc_layer_um"] for pc in sweep}) >= 3
+        assert len({pc.params["contact.speed"] for pc in sweep}) >= 5
+        assert len({pc.params["supply.disc_layer"] for pc in sweep}) >= 3
         directions = {pc.ramp["direction"] for pc in plan if pc.ramp}
         assert directions == {"up", "down"}
+
+
+def test_shipped_batch_specs_keep_their_case_ids():
+    """The case ids name the cases' folders: the batch spec's keys in SI give the ids the
+    display-unit keys gave."""
+    _, plan = load_plan(ROOT / "examples" / "batches" / "default.toml")
+    assert [pc.id for pc in plan] == [f"u{u}_s1.5um_T40_F20_coarse"
+                                      for u in ("05.0", "08.0", "12.0", "17.0", "25.0")]
+    _, plan = load_plan(ROOT / "examples" / "batches" / "breakthrough_release_low.toml")
+    assert [pc.id for pc in plan] == [f"rampR_up0{k}_u{u}_s8um_T40_F20_coarse"
+                                      for k, u in enumerate(("05.0", "06.5", "08.0", "09.5"),
+                                                            start=1)]
+    _, plan = load_plan(ROOT / "examples" / "batches" / "regime.toml")
+    assert plan[3].id == "u08.0_s1um_T40_F20_coarse" and plan[25].id == \
+        "rampA_up01_u05.0_s1.5um_T40_F20_coarse"
 
 
 @pytest.mark.parametrize("path", sorted((Path(__file__).resolve().parents[2] / "examples")
                                         .glob("*/*.toml")), ids=lambda p: p.name)
 def test_tracked_specs_are_valid(path):
-    """Every spec under runs/ that the docs tell users to run is a valid case spec, or a batch
+    """Every spec under examples/ that the docs tell users to run is a valid case spec, or a batch
     spec that expands into valid case specs: a renamed or retired key fails here, not in a
     user's hands."""
     from ehlfoam._io import read_toml

@@ -1,4 +1,4 @@
-"""Per-face lists that foamlib would misread (generator/foam_lists.py): a scalar list of 3
+"""Per-face lists that foamlib would misread (ehlfoam.case.foam_lists): a scalar list of 3
 values and a symmTensor list of 3 faces go in through placeholders and read back as written."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Navier slip on the walls (generator/wall_slip.py): the directionMixed entry's algebra, its
+"""Navier slip on the walls (ehlfoam.case.wall_slip): the directionMixed entry's algebra, its
 writing, and that v1912's solver holds the wall's fluid at u_s - U_w = lambda du/dn."""
 
 from __future__ import annotations
@@ -10,7 +10,8 @@ import pytest
 from foamlib import FoamFieldFile
 
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import case_mesh, load_spec_of, write_case
+from ehlfoam.case.geometry import load_spec_of
+from ehlfoam.case.writer import case_mesh, write_case
 from ehlfoam.gap.source import load_gap
 from ehlfoam.case.wall_slip import navier_slip, slip_fraction, wall_normals
 from ehlfoam.run import fields as case_fields
@@ -58,6 +59,7 @@ def test_spec_refuses_a_slip_beyond_its_range():
         make_case_spec({**SMALL, "physics": {"wall_slip_length": 1e-3}})
 
 
+@pytest.mark.openfoam
 def test_solver_holds_the_walls_fluid_at_the_navier_slip(slip_case, tmp_path):
     """After 1 ms of the single-phase flow, every disc and ball face's written velocity is the
     wall's plus (1 - f) of its cell's tangential velocity relative to the wall, and none

@@ -1,6 +1,6 @@
 """`ehlfoam precalc`: the JSON/npz/png output contract, the TOML route, exit codes and bad input.
 
-Exit codes: 0 converged, 1 not converged (outputs written), 2 bad input (nothing written).
+Exit codes: 0 converged, 3 not converged (outputs written), 2 bad input (nothing written).
 """
 
 from __future__ import annotations
@@ -155,11 +155,11 @@ def test_toml_top_level_keys_and_override(tmp_path):
 
 # --- not converged ---------------------------------------------------------------------------------
 
-def test_not_converged_exit_1_with_outputs(tmp_path, capsys):
+def test_not_converged_exit_3_with_outputs(tmp_path, capsys):
     out = tmp_path / "out"
     rc, _, err = run_cli(capsys, "--load", "20", "--speed", "0.01", "--temperature", "40",
                          "--grid", "65", "--max-cycles", "1", "--out", out)
-    assert rc == 1
+    assert rc == 3                    # EXIT_NOT_CONVERGED: not the bad-input 2
     assert "not converged" in err.lower()
     s = strict_json(out / "summary.json")
     assert s["converged"] is False

@@ -1,4 +1,4 @@
-"""Elastic deformation kernel of ehl_precalc against independent references.
+"""Elastic deformation kernel of ehlfoam.contact against independent references.
 
 References used here (none of them is the code's own output):
   * the closed-form integral of 1/r over a rectangle (self-influence of a cell) and

@@ -1,4 +1,4 @@
-"""Hertz theory, Moes groups, film-thickness formulas and lubricant laws of ehl_precalc.
+"""Hertz theory, Moes groups, film-thickness formulas and lubricant laws of ehlfoam.contact.
 
 The expected values are the reference numbers of the project (van Emden 2017: 20 N,
 R = 9.525 mm, E' = 1.11e11 Pa, HVI60 at 40 C, 10 mm/s -> a = 0.137 mm, pH = 0.509 GPa,

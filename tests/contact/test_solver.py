@@ -126,6 +126,7 @@ def test_high_pressure_viscosity_light_load_converges():
     assert 0 < s["hmin_m"] < s["hc_m"]
 
 
+@pytest.mark.slow
 def test_stalled_large_L_solve_switches_relaxation_and_converges():
     """M = 100, L = 20 on 257^2 (alpha pH ~ 34) with the distributive-Jacobi factor of the
     small-L contacts (0.5, not the 0.2 used above L = 15): the cycles fall into a limit cycle

@@ -47,6 +47,7 @@ def _ehlfoam(*args: str, env: dict[str, str] | None = None) -> subprocess.Comple
 
 
 # ------------------------------------------------------------------ real runs
+@pytest.mark.openfoam
 def test_embedded_runtime_passes_build_check(embedded: FoamRuntime, tmp_path: Path) -> None:
     result = check_build(embedded, workdir=tmp_path)
     assert result.error is not None, result.log[-2000:]
@@ -55,11 +56,13 @@ def test_embedded_runtime_passes_build_check(embedded: FoamRuntime, tmp_path: Pa
     assert (tmp_path / "pitzDaily" / "log.potentialFoam").is_file()
 
 
+@pytest.mark.openfoam
 def test_configured_runtime_passes_build_check(runtime: FoamRuntime) -> None:
     result = check_build(runtime)
     assert result.ok, result.summary()
 
 
+@pytest.mark.openfoam
 def test_missing_app_raises_clear_error(runtime: FoamRuntime, tmp_path: Path) -> None:
     with pytest.raises(FoamError) as info:
         runtime.run("noSuchFoamApp", [], cwd=tmp_path)
@@ -68,6 +71,7 @@ def test_missing_app_raises_clear_error(runtime: FoamRuntime, tmp_path: Path) ->
     assert str(tmp_path) in msg
 
 
+@pytest.mark.openfoam
 def test_failing_app_reports_app_case_and_log_tail(runtime: FoamRuntime,
                                                    tmp_path: Path) -> None:
     log = tmp_path / "log.blockMesh"
@@ -79,12 +83,14 @@ def test_failing_app_reports_app_case_and_log_tail(runtime: FoamRuntime,
     assert log.read_text().strip(), "the log must hold the application's output"
 
 
+@pytest.mark.openfoam
 def test_failing_app_with_check_false_returns(runtime: FoamRuntime, tmp_path: Path) -> None:
     res = runtime.run("blockMesh", [], cwd=tmp_path, check=False)
     assert res.returncode != 0
     assert res.stdout
 
 
+@pytest.mark.openfoam
 def test_embedded_host_tools_unaffected(embedded: FoamRuntime) -> None:
     # the runtime's library path must never leak into the environment
     env = embedded.env({"PATH": "/usr/bin:/bin"})
@@ -113,6 +119,7 @@ def test_debian12_native_build_is_refused() -> None:
 
 
 # ----------------------------------------------------------------- the CLI
+@pytest.mark.openfoam
 def test_doctor_exits_0() -> None:
     res = _ehlfoam("doctor")
     assert res.returncode == 0, res.stdout + res.stderr
@@ -173,6 +180,7 @@ def test_embedded_command_construction(tmp_path: Path) -> None:
         rt.run("blockMesh", [], cwd=tmp_path)
 
 
+@pytest.mark.openfoam
 def test_embedded_library_path_is_real(embedded: FoamRuntime) -> None:
     dirs = embedded.library_path()
     assert dirs and all(Path(d).is_dir() for d in dirs)

@@ -1,4 +1,4 @@
-"""Tests of ehlfoam.mesh.mesh: gmsh base mesh, extrusion, polyMesh writer.
+"""Tests of ehlfoam.mesh: gmsh base mesh, extrusion, polyMesh writer.
 
 Real gmsh and real OpenFOAM (checkMesh through ehlfoam.foam.runtime), no
 mocks. Geometry: the reference contact (ball radius 9.525 mm, Hertz radius
@@ -15,7 +15,8 @@ import gmsh
 import numpy as np
 import pytest
 
-from ehlfoam.mesh.mesh import (PATCH_TYPES, BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch, write_polymesh)
+from ehlfoam.mesh import (PATCH_TYPES, BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude,
+                          gap_mismatch, write_polymesh)
 from ehlfoam.foam.runtime import FoamRuntime
 
 R_BALL = 9.525e-3   # m
@@ -297,6 +298,7 @@ def test_write_polymesh_files(coarse: PolyMesh, tmp_path: Path) -> None:
     assert first == "4(%d %d %d %d)" % tuple(coarse.faces[0])
 
 
+@pytest.mark.openfoam
 def test_checkmesh_ok_on_realistic_mesh(reference: PolyMesh, runtime: FoamRuntime,
                                         tmp_path: Path) -> None:
     case = write_case(reference, tmp_path / "reference")
@@ -305,6 +307,7 @@ def test_checkmesh_ok_on_realistic_mesh(reference: PolyMesh, runtime: FoamRuntim
     assert stats["total_volume"] == pytest.approx(reference.cell_volumes.sum(), rel=1e-5)
 
 
+@pytest.mark.openfoam
 def test_full_domain_is_the_half_mirrored(coarse: PolyMesh, coarse_base: BaseMesh,
                                            runtime: FoamRuntime, tmp_path: Path) -> None:
     p_full = params(symmetric=False)
@@ -327,6 +330,7 @@ def test_full_domain_is_the_half_mirrored(coarse: PolyMesh, coarse_base: BaseMes
     check_mesh(runtime, write_case(full, tmp_path / "full"))
 
 
+@pytest.mark.openfoam
 def test_full_domain_with_uneven_size_is_meshed_whole(runtime: FoamRuntime,
                                                       tmp_path: Path) -> None:
     p_full = params(symmetric=False)
@@ -343,6 +347,7 @@ def test_full_domain_with_uneven_size_is_meshed_whole(runtime: FoamRuntime,
     check_mesh(runtime, write_case(full, tmp_path / "uneven"))
 
 
+@pytest.mark.openfoam
 def test_polar_ring_is_log_polar_and_the_rest_is_free(runtime: FoamRuntime,
                                                        tmp_path: Path) -> None:
     r_polar = 4 * A_HERTZ
@@ -473,7 +478,7 @@ def test_bad_gap_and_layers_raise_value_error(coarse_base: BaseMesh) -> None:
 
 # ---------------------------------------------------------------- grading and patch split
 def test_layer_fractions_graded_toward_both_walls():
-    from ehlfoam.mesh.mesh import layer_fractions
+    from ehlfoam.mesh import layer_fractions
 
     f = layer_fractions(8, 4.0)
     d = np.diff(f)
@@ -487,7 +492,7 @@ def test_wall_steps_count_the_ball_stair_steps():
     """A square quad of side d under a ball sloping by g in x: the ball rises g d across it,
     which is g d / (f_1 h_mean) wall cells of height f_1 h_mean; thinner wall cells (graded
     layers) step over proportionally more of them."""
-    from ehlfoam.mesh.mesh import layer_fractions, wall_steps
+    from ehlfoam.mesh import layer_fractions, wall_steps
 
     d, h0, g = 1e-4, 1e-5, 0.05
     base = BaseMesh(points=np.array([[0.0, 0.0], [d, 0.0], [d, d], [0.0, d]]),
@@ -562,7 +567,7 @@ def test_normal_columns_meet_the_levels_at_right_angles(coarse_base: BaseMesh) -
 
 
 def test_split_patch_keeps_a_valid_mesh():
-    from ehlfoam.mesh.mesh import split_patch
+    from ehlfoam.mesh import split_patch
 
     params = MeshParams(x_min=-6 * A_HERTZ, x_max=12 * A_HERTZ, y_max=6 * A_HERTZ, island_radius=1.5 * A_HERTZ,
                         n_layers=3)
@@ -586,7 +591,7 @@ def test_one_wall_cell_height_grades_each_column_just_enough(coarse_base):
     """``wall_cell``: the wall cell is that height wherever the gap allows it (graded between
     uniform and 100), uniform where the gap is too thin for it, graded 100 where even that
     leaves it thicker; each cell's span across its column is what its nodes make."""
-    from ehlfoam.mesh.mesh import column_fractions, layer_fractions
+    from ehlfoam.mesh import column_fractions, layer_fractions
 
     n = 10
     h = np.array([5e-6, 2e-5, 1e-4, 2e-4, 1e-2])

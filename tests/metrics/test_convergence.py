@@ -1,6 +1,6 @@
-"""runs/convergence.py: the observed order and grid convergence index (Celik et al. 2008) on
-metrics with a known limit: f(h) = f0 + C h^p; and the means over a window of writes that
-bench/mesh_convergence.py compares."""
+"""ehlfoam.metrics.convergence: the observed order and grid convergence index (Celik et al.
+2008) on metrics with a known limit: f(h) = f0 + C h^p; the means over a window of writes that
+it compares; and the rest a metric relaxes to, from runs that approach it."""
 
 from __future__ import annotations
 
@@ -12,9 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bench.mesh_convergence import at_time
-from bench.rest_value import main as rest_value_main
-from ehlfoam.case.writer import META
+from ehlfoam.case.geometry import META
 from ehlfoam.metrics.convergence import METRICS, last_transit, observed_order, rest_value, window_mean
 from tests.tiny import tiny_geometry
 
@@ -94,15 +92,13 @@ def test_a_window_averages_out_a_meniscus_that_jumps_write_by_write(tmp_path):
     # writes every 0.01 s (a tenth of a transit); the inlet jumps 4.5 / 5.5 a write by write
     times = np.round(np.arange(1, 61) * 0.01, 6)
     case = _case_with_history(tmp_path / "c", times, np.where(np.arange(60) % 2, 5.5, 4.5))
-    one = at_time(case, 0.3)
-    assert one["inlet_meniscus_distance_over_a"] in (4.5, 5.5)
-    mean = at_time(case, 0.3, window=0.5)         # the writes at 0.25-0.30 s
+    mean = window_mean(case, 0.3, 0.5)            # the writes at 0.25-0.30 s
     assert mean["writes_averaged"] == 6
     assert mean["inlet_meniscus_distance_over_a"] == pytest.approx(5.0)
     assert mean["flooded_width_over_a"] == pytest.approx(12.275)
     assert mean["jitter"]["inlet_meniscus_distance_over_a"] == pytest.approx(0.5)
     assert mean["time_s"] == pytest.approx(0.3)
-    assert at_time(case, 0.9, window=0.5) is None     # the run never got there
+    assert window_mean(case, 0.005, 0.5) is None      # before the first write
     last = last_transit(case)                         # the writes at 0.5-0.6 s
     assert last["writes_averaged"] == 11 and last["time_s"] == pytest.approx(0.6)
     assert last == window_mean(case, None, 1.0)
@@ -177,41 +173,3 @@ def test_too_few_writes_are_refused():
         rest_value([(t, t), (t[:1], t[:1])])
     with pytest.raises(ValueError, match="4 in all"):
         rest_value([(t, t)])
-
-
-def test_rest_value_bench_reads_two_histories(tmp_path, capsys):
-    # writes every 0.0012 s = 0.012 transits (transit 0.1 s); the second run from 0.036 on
-    t = np.arange(1, 17) * 0.0012
-    above = _case_with_history(tmp_path / "above", t, np.full(t.size, 5.0),
-                               _relaxing(t / 0.1, 15.45))
-    below = _case_with_history(tmp_path / "below", t, np.full(t.size, 5.0),
-                               np.r_[np.full(2, 14.5), _relaxing(t[2:] / 0.1, 14.86)])
-    assert rest_value_main([str(above), f"{below}@0.036", "--save",
-                            str(tmp_path / "rest.json")]) == 0
-    record = json.loads((tmp_path / "rest.json").read_text())
-    width = record["metrics"]["flooded_width_over_a"]
-    assert width["rest"] == pytest.approx(15.07, abs=1e-5)
-    assert width["runs"][1]["writes"] == 14 and width["runs"][1]["first"] == pytest.approx(14.86)
-    out = capsys.readouterr().out
-    assert "rest 15.070" in out
-    assert width["consistent"] is True and "agree: one relaxation fits them all" in out
-
-
-def test_rest_chart_draws_brackets_and_leaves_out_undetermined_fits(tmp_path, capsys):
-    """bench/rest_chart.py: a record per mesh as rest_value.py writes it; a fit whose
-    relaxation time is not determined is not drawn and says so."""
-    from bench.rest_chart import determined, main as chart_main
-
-    above, below = np.arange(1, 16) * 0.012, np.arange(1, 17) * 0.012
-    two = rest_value([(above, _relaxing(above, 15.45)), (below, _relaxing(below, 14.86))])
-    line = np.arange(6, 20) * 0.012
-    straight = rest_value([(line, 15.42 - 1.8 * (line - line[0]))])
-    assert determined(two) and not determined(straight)
-    for name, r in (("two.json", two), ("straight.json", straight)):
-        (tmp_path / name).write_text(json.dumps({"metrics": {"flooded_width_over_a": r}}))
-    png = tmp_path / "chart.png"
-    assert chart_main([f"{tmp_path / 'two.json'}@0.06", f"{tmp_path / 'straight.json'}@0.03",
-                       "--metrics", "flooded_width_over_a", "--out", str(png)]) == 0
-    out = capsys.readouterr().out
-    assert "0.06: fit 15.070 +- 0.000, bracket" in out and "0.03: fit not determined" in out
-    assert png.stat().st_size > 10_000

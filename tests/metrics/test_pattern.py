@@ -1,4 +1,4 @@
-"""Flow-pattern metrics (runs/metrics.py) on synthetic alpha fields with known answers.
+"""Flow-pattern metrics (ehlfoam.metrics.pattern) on synthetic alpha fields with known answers.
 
 The fields are smooth steps (tanh, width 0.2 a) of analytic signed distances,
 sampled at scattered "cell centres" (a jittered grid, or uniform random

@@ -8,8 +8,8 @@ are opened in headless Chromium, which must load every image.
 
 from __future__ import annotations
 
-import argparse
 import csv
+import fcntl
 import json
 import os
 import re
@@ -24,14 +24,17 @@ import pytest
 from PIL import Image
 
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from ehlfoam.run.fields import time_folders
-from ehlfoam.report import add_parser, report, report_batch, report_case
+from ehlfoam.cli.main import main
+from ehlfoam.report import report, report_batch, report_case
 from ehlfoam.report import units
 from ehlfoam.report.charts import bubble_relation_x, fit_bubble_relation
 from ehlfoam.report.fields import load_fields
 from ehlfoam.report.side_view import cut_at_axis
 from ehlfoam.report.style import AIR_RGB, OIL_RGB
+from ehlfoam.batch.regime import write_regime
 from ehlfoam.run.monitor import run_case
 from tests.tiny import SMALL
 
@@ -77,6 +80,7 @@ def _png(path: Path) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ the case report
+@pytest.mark.openfoam
 def test_case_report_has_every_part(case_report, finished_case):
     index, _ = case_report
     assert index == finished_case / "report" / "index.html"
@@ -98,9 +102,10 @@ def test_case_report_has_every_part(case_report, finished_case):
     assert "<td>nl</td>" in html and "<td>mm/s</td>" in html
     assert f"{metrics['cells']:,}" in html
     assert "interFoam" in html and "OPENFOAM=" in html            # solver and build
-    # (its cost is measured by bench/report_bench.py, not asserted here)
+    # (its cost is timed elsewhere, not asserted here)
 
 
+@pytest.mark.openfoam
 def test_top_view_meniscus_lies_where_the_metrics_say(case_report, finished_case):
     """Along y = 0 upstream of the island the PNG's black meniscus line is at
     x = -(1 + inlet_meniscus_distance_over_a) a, within two pixels."""
@@ -124,6 +129,7 @@ def test_top_view_meniscus_lies_where_the_metrics_say(case_report, finished_case
     assert abs(x_png - x_expected) <= 2.0 / sx * 1e-3, (x_png / geom.a, x_expected / geom.a)
 
 
+@pytest.mark.openfoam
 def test_top_view_oil_and_air_colours(case_report, finished_case):
     """A pixel inside the puddle (oil in the raster) has the oil colour, one in the far
     corner (air) the air colour."""
@@ -149,6 +155,7 @@ def test_top_view_oil_and_air_colours(case_report, finished_case):
     check(geom.x_max - 0.6 * geom.a, geom.y_max - 1.5 * geom.a, AIR_RGB, (0.0, 0.01))
 
 
+@pytest.mark.openfoam
 def test_side_view_gap_grows_away_from_the_contact(finished_case):
     geom = load_geometry(finished_case)
     cut = cut_at_axis(load_fields(finished_case, geom))
@@ -162,6 +169,7 @@ def test_side_view_gap_grows_away_from_the_contact(finished_case):
     assert np.all((cut.alpha >= 0) & (cut.alpha <= 1)) and len(cut.triangles) > 50
 
 
+@pytest.mark.openfoam
 def test_failed_case_says_so_with_the_log_tail(finished_case, tmp_path):
     case = _failed_copy(finished_case, tmp_path / "failed")
     index = report_case(case, animate=False)
@@ -174,12 +182,18 @@ def test_failed_case_says_so_with_the_log_tail(finished_case, tmp_path):
     assert thumb[5, 5, 0] > 150 and thumb[5, 5, 1] < 80        # the red FAILED stamp
 
 
+@pytest.mark.openfoam
 def test_running_and_never_run_cases(finished_case, tmp_path):
     running = _copy(finished_case, tmp_path / "running")
     (running / "metrics.json").write_text(json.dumps({"status": "running", "cells": 1}))
-    html = report_case(running, animate=False).read_text()
+    with open(running / "ehlfoam" / "run.lock", "a") as lock:   # a live run holds it
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        html = report_case(running, animate=False).read_text()
     assert "Status: running" in html and "still going" in html
     assert "Last lines of the solver log" in html
+    # no process holds the lock: the run was killed and left metrics.json running
+    html = report_case(running, animate=False).read_text()
+    assert "Status: interrupted" in html and "monitor_killed" in html
 
     fresh = _copy(finished_case, tmp_path / "fresh")
     for _, folder in time_folders(fresh):
@@ -191,6 +205,7 @@ def test_running_and_never_run_cases(finished_case, tmp_path):
     assert "What could not be shown" not in html
 
 
+@pytest.mark.openfoam
 def test_broken_case_reports_problems_instead_of_crashing(finished_case, tmp_path):
     case = _copy(finished_case, tmp_path / "broken")
     last = time_folders(case)[-1][1]
@@ -204,25 +219,23 @@ def test_broken_case_reports_problems_instead_of_crashing(finished_case, tmp_pat
     assert info["fields_time_s"] < float(last.name)
 
 
+@pytest.mark.openfoam
 def test_report_detects_case_and_batch_and_bad_input(finished_case, tmp_path):
     with pytest.raises(FileNotFoundError):
         report(tmp_path / "nowhere")
     (tmp_path / "empty").mkdir()
     with pytest.raises(ValueError, match="neither a case"):
         report(tmp_path / "empty")
-    parser = argparse.ArgumentParser()
-    add_parser(parser.add_subparsers(dest="command"))
-    args = parser.parse_args(["report", str(tmp_path / "empty")])
-    assert args.func(args) == 2
-    args = parser.parse_args(["report", str(tmp_path / "nowhere")])
-    assert args.func(args) == 2
+    assert main(["report", str(tmp_path / "empty")]) == 2
+    assert main(["report", str(tmp_path / "nowhere")]) == 2
 
 
+@pytest.mark.openfoam
 def test_cli_module_off_screen(finished_case, tmp_path):
-    """``python -m ehlfoam.report CASE`` in a process with no display at all."""
+    """``python -m ehlfoam report CASE`` in a process with no display at all."""
     case = _copy(finished_case, tmp_path / "cli")
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-    proc = subprocess.run([sys.executable, "-m", "ehlfoam.report", str(case),
+    proc = subprocess.run([sys.executable, "-m", "ehlfoam", "report", str(case),
                            "--no-gif"], cwd=ROOT, env=env, capture_output=True, text=True,
                           timeout=120)
     assert proc.returncode == 0, proc.stderr
@@ -238,18 +251,21 @@ def batch(finished_case, case_report, tmp_path_factory) -> Path:
     shutil.copytree(finished_case, ok)                       # with its report/
     _failed_copy(finished_case, root / "cases" / "bad")
     m = json.loads((ok / "metrics.json").read_text())
-    columns = ["case_id", "speed_mm_s", "temperature_C", "load_N", "supply", "disc_layer_um",
-               "ball_layer_um", "status", "end_reason", "reason", "state", "wall_s", "cells",
-               "case_dir", "log", "inlet_meniscus_distance_over_a", "wake_gas_length_over_a"]
-    rows = [{"case_id": "ok", "speed_mm_s": 20, "temperature_C": 40, "load_N": 20,
-             "supply": "layers", "disc_layer_um": 3, "ball_layer_um": 3,
+    columns = ["case_id", "contact.speed", "contact.temperature", "contact.load",
+               "supply.mode", "supply.disc_layer", "supply.ball_layer", "status", "end_reason",
+               "reason", "state", "wall_s", "cells", "case_dir", "log",
+               "inlet_meniscus_distance_over_a", "wake_gas_length_over_a"]
+    rows = [{"case_id": "ok", "contact.speed": 0.02, "contact.temperature": 40,
+             "contact.load": 20, "supply.mode": "layers", "supply.disc_layer": 3e-6,
+             "supply.ball_layer": 3e-6,
              "status": "finished", "end_reason": "end_time", "reason": "", "state": m["state"],
              "wall_s": m["wall_s"], "cells": m["cells"], "case_dir": "cases/ok",
              "log": "cases/ok/log.interFoam",
              "inlet_meniscus_distance_over_a": m["inlet_meniscus_distance_over_a"],
              "wake_gas_length_over_a": m["wake_gas_length_over_a"]},
-            {"case_id": "bad", "speed_mm_s": 40, "temperature_C": 40, "load_N": 20,
-             "supply": "layers", "disc_layer_um": 3, "ball_layer_um": 3, "status": "failed",
+            {"case_id": "bad", "contact.speed": 0.04, "contact.temperature": 40,
+             "contact.load": 20, "supply.mode": "layers", "supply.disc_layer": 3e-6,
+             "supply.ball_layer": 3e-6, "status": "failed",
              "end_reason": "diverged", "reason": "solver diverged: time step collapsed",
              "state": "", "wall_s": 3.0, "cells": m["cells"], "case_dir": "cases/bad",
              "log": "cases/bad/log.interFoam"}]
@@ -261,13 +277,15 @@ def batch(finished_case, case_report, tmp_path_factory) -> Path:
             {"id": "bad", "params": {"contact.speed": 0.04}, "ramp": None},
             {"id": "later", "params": {"contact.speed": 0.06}, "ramp": None}]
     (root / "plan.json").write_text(json.dumps(plan))
-    (root / "regime").mkdir()
-    shutil.copy(ok / "report" / "thumb.png", root / "regime" / "map.png")
-    (root / "regime" / "regime.json").write_text(json.dumps(
-        {"summary": ["T 40 C, F 20 N, 1um, coarse: I -> II at 12.5 +- 2.5 mm/s"]}))
+    line = [{"case_id": f"u{u}", "contact.speed": u * 1e-3, "contact.temperature": 40.0,
+             "contact.load": 20.0, "supply.mode": "layers", "supply.disc_layer": 1e-6,
+             "supply.ball_layer": 1e-6, "mesh.resolution": "coarse", "status": "finished",
+             "state": state} for u, state in ((10, "I"), (15, "II"))]
+    write_regime(root, line)
     return root
 
 
+@pytest.mark.openfoam
 def test_batch_report_index_failures_and_reuse(batch):
     before = (batch / "cases" / "ok" / "report" / "report.json").stat().st_mtime
     index = report_batch(batch, jobs=1)
@@ -283,8 +301,9 @@ def test_batch_report_index_failures_and_reuse(batch):
     assert (index.parent / "../cases/bad/log.interFoam").resolve().is_file()
     assert LOG_MARKER in html                                  # its last log line
     assert "later" in html and "pending" in html
-    assert "I -&gt; II at 12.5 +- 2.5 mm/s" in html              # regime.json's summary
-    assert 'src="../regime/map.png"' in html
+    assert "T 40 C, F 20 N, 1um, coarse: I -&gt; II at 12.5 +- 2.5 mm/s" in html  # regime.json
+    assert 'src="regime_speed_supply.png"' in html and "u [mm/s]" in html
+    assert "3 / 3" in html                                      # the layers in um
     assert "not enough points" in html                          # one state I point only
     for src in re.findall(r'<img src="([^"]+)"', html):
         assert (index.parent / src).resolve().is_file(), src
@@ -334,6 +353,7 @@ def _loaded_images(page: Path, tmp_path: Path) -> tuple[int, int]:
     return int(loaded.group(1)), int(total.group(1))
 
 
+@pytest.mark.openfoam
 def test_pages_load_every_image_in_chromium(case_report, batch, tmp_path):
     index, _ = case_report
     loaded, total = _loaded_images(index, tmp_path)
@@ -345,6 +365,7 @@ def test_pages_load_every_image_in_chromium(case_report, batch, tmp_path):
     assert total >= 3 and loaded == total
 
 
+@pytest.mark.openfoam
 def test_browser_check_sees_a_missing_image(case_report, tmp_path):
     """The counter is not a formality: a page with a broken link counts one image short."""
     index, _ = case_report
@@ -357,13 +378,14 @@ def test_browser_check_sees_a_missing_image(case_report, tmp_path):
     assert loaded == total - 1
 
 
+@pytest.mark.openfoam
 def test_batch_report_reads_the_mesh_convergence_of_three_levels(finished_case, case_report,
                                                                   tmp_path):
     """Three copies of a real case, filed as coarse / medium / fine with far-field cells of
     0.8 / 0.55 / 0.38 a, their histories rewritten: a width that follows 12 + 3 h^2 reads as
     converging at order 2 towards 12 a; an inlet meniscus whose level means differ by less
     than its own jitter reads as within noise. A fourth case at another speed is left out."""
-    from ehlfoam.report.batch import convergence_groups
+    from ehlfoam.report.batch_tables import convergence_groups
 
     root = tmp_path / "conv"
     sizes = {"coarse": 0.8, "medium": 0.55, "fine": 0.38}
@@ -383,11 +405,13 @@ def test_batch_report_reads_the_mesh_convergence_of_three_levels(finished_case, 
             w = csv.DictWriter(fh, fieldnames=list(hist[0]))
             w.writeheader()
             w.writerows(hist)
-        rows.append({"case_id": level, "speed_mm_s": 20, "temperature_C": 40, "load_N": 20,
-                     "supply": "layers", "disc_layer_um": 3, "ball_layer_um": 3,
-                     "resolution": level, "status": "finished", "case_dir": f"cases/{level}"})
+        rows.append({"case_id": level, "contact.speed": 0.02, "contact.temperature": 40,
+                     "contact.load": 20, "supply.mode": "layers", "supply.disc_layer": 3e-6,
+                     "supply.ball_layer": 3e-6, "mesh.resolution": level,
+                     "status": "finished", "case_dir": f"cases/{level}"})
     _copy(finished_case, root / "cases" / "other")
-    rows.append({**rows[0], "case_id": "other", "speed_mm_s": 40, "case_dir": "cases/other"})
+    rows.append({**rows[0], "case_id": "other", "contact.speed": 0.04,
+                 "case_dir": "cases/other"})
     with open(root / "results.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()

@@ -1,5 +1,5 @@
 """The following levels (``mesh.follow``): a mesh with bands of the level's cells along the
-meniscus of the state the case starts from (runs/follow_meniscus.py)."""
+meniscus of the state the case starts from (ehlfoam.seed.follow)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,11 @@ import numpy as np
 import pytest
 
 from ehlfoam.errors import SpecError
-from ehlfoam.spec.case import (FOLLOW_BASE, FOLLOW_LEVELS, FOLLOW_POLAR_RADIUS, RefineBand, SideBox, make_case_spec)
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.spec.case import make_case_spec
+from ehlfoam.spec.levels import FOLLOW_BASE, FOLLOW_LEVELS, FOLLOW_POLAR_RADIUS
+from ehlfoam.spec.mesh import RefineBand, SideBox
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from ehlfoam.seed.band import side_bands
 from tests.case.test_writer import EHLFOAM, _thin_film_state, _toml
 from tests.tiny import SMALL
@@ -136,10 +139,11 @@ def test_cli_case_follows_the_meniscus_of_the_state_it_starts_from(tmp_path):
 
 
 def test_the_shipped_resolved_nominal_spec_is_the_converged_families_medium_level():
-    """runs/nominal_resolved.toml: the nominal case on the medium following level under the
-    contact-line model whose three levels converge (docs/cases.md, "The front in the side
-    cells on all three levels"): the side band round the front off the track, walls halving
-    with the side cells, 1 um slip, a 43 deg wall."""
+    """examples/cases/nominal_resolved.toml: the nominal case on the medium following level
+    under the contact-line model whose three levels converge
+    (docs/models/interface.md#the-contact-line-model-and-what-converges): the side band
+    round the front off the track, walls halving with the side cells, 1 um slip, a 43 deg
+    wall."""
     from ehlfoam.spec.case import load_case_spec
 
     spec = load_case_spec(ROOT / "examples" / "cases" / "nominal_resolved.toml")

@@ -1,4 +1,4 @@
-"""Interpolation of cell values between two generated layered meshes (runs/field_mapping.py)."""
+"""Interpolation of cell values between two generated layered meshes (ehlfoam.seed.mapping)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,8 @@ import pytest
 from scipy.spatial import Delaunay
 
 from ehlfoam.spec.case import make_case_spec
-from ehlfoam.case.writer import load_geometry, write_case
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
 from ehlfoam.run.fields import Structure
 from ehlfoam.seed.mapping import LayeredMesh, carry_oil, conserve_oil, interpolate, oil_carried
 from tests.tiny import SMALL

@@ -1,4 +1,4 @@
-"""The thin-film model of the flooded region (ehlfoam.thinfilm.model): a strip against
+"""The thin-film model of the flooded region (ehlfoam.thinfilm): a strip against
 its 1D theory, a region round an island, films, metrics and bad input."""
 
 from __future__ import annotations
@@ -8,7 +8,8 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from ehlfoam.thinfilm.model import (Grid, ThinFilmProblem, ThinFilmSolution, landau_levich, region_metrics, solve_thin_film)
+from ehlfoam.thinfilm import (Grid, ThinFilmProblem, ThinFilmSolution, landau_levich,
+                              region_metrics, solve_thin_film)
 
 ETA, U, SIGMA, THETA = 0.02, 0.01, 0.03, 15.0
 
@@ -120,18 +121,18 @@ def test_thicker_films_hold_less_oil_in_a_narrower_region():
 def test_the_receding_pull_acts_where_the_walls_leave_the_meniscus(receding, pull):
     """On a round region the open cells get the full pull straight behind it, none ahead
     of it or beside it, and n^(2/3) of it in between."""
-    from ehlfoam.thinfilm.model import _Operators, _touches
+    from ehlfoam.thinfilm.operators import Operators, touches
 
     prob = ball_problem(receding_meniscus=receding, cell=0.2 * A)
     grid = Grid.build(prob)
-    ops = _Operators(prob, grid)
+    ops = Operators(prob, grid)
     X, Y = np.meshgrid(grid.x, grid.y)
     flooded = (np.hypot(X, Y) < 6 * A) & ~grid.island
     factor = ops.pull_factor(flooded)
     if pull is None:
         cos_t = np.cos(np.radians(THETA))
         pull = (1 + 3.8 * (0.0216 * 0.008 / SIGMA) ** (2 / 3)) / cos_t
-    edge = _touches(flooded) & ~grid.island
+    edge = touches(flooded) & ~grid.island
     rear = edge[0] & (grid.x > 0)
     front = edge[0] & (grid.x < 0)
     assert factor[0, rear] == pytest.approx(pull, rel=1e-3)
@@ -142,7 +143,7 @@ def test_the_receding_pull_acts_where_the_walls_leave_the_meniscus(receding, pul
     assert factor[at45] == pytest.approx(1 + (pull - 1) * np.cos(np.pi / 4) ** (2 / 3),
                                          rel=0.02)
     assert (factor[~edge & ~flooded & ~grid.island] >= 1.0).all()
-    static = _Operators(ball_problem(receding_meniscus=1.0), grid)
+    static = Operators(ball_problem(receding_meniscus=1.0), grid)
     assert np.all(static.pull_factor(flooded) == 1.0)
 
 
@@ -151,15 +152,15 @@ def test_the_advancing_angle_acts_where_dry_walls_run_into_the_meniscus():
     take cos(theta_a) / cos(theta_s) of the static suction, beside it none of the change,
     and in between Cox-Voinov's theta^3 at the share of the walls' speed into it; on the
     track, where the supply's layers meet it, the static suction stays."""
-    from ehlfoam.thinfilm.model import _Operators, _touches
+    from ehlfoam.thinfilm.operators import Operators, touches
 
     prob = ball_problem(advancing_angle=47.0, cell=0.2 * A, track_half_width=2 * A)
     grid = Grid.build(prob)
-    ops = _Operators(prob, grid)
+    ops = Operators(prob, grid)
     X, Y = np.meshgrid(grid.x, grid.y)
     flooded = (np.hypot(X, Y) < 6 * A) & ~grid.island
     factor = ops.pull_factor(flooded)
-    edge = _touches(flooded) & ~grid.island
+    edge = touches(flooded) & ~grid.island
     ts, ta = np.radians(THETA), np.radians(47.0)
     assert factor[0, edge[0] & (grid.x < 0)] == pytest.approx(1.0)       # on the track
     assert factor[0, edge[0] & (grid.x > 0)] == pytest.approx(1.0)       # the rear
@@ -171,7 +172,7 @@ def test_the_advancing_angle_acts_where_dry_walls_run_into_the_meniscus():
     expected = np.cos(np.cbrt(ts**3 + m * (ta**3 - ts**3))) / np.cos(ts)
     assert factor[at135] == pytest.approx(expected, rel=0.03)
     assert expected < 0.85                    # a weaker suction than the static one
-    static = _Operators(ball_problem(cell=0.2 * A), grid)
+    static = Operators(ball_problem(cell=0.2 * A), grid)
     assert np.all(static.pull_factor(flooded) == 1.0)
 
 
@@ -181,13 +182,13 @@ def test_a_normal_length_in_metres_gives_every_grid_the_same_pull():
     cells against the mean of the fine cells in them): 90 % of them within 2.5 % of the
     pull's excess at 0.6 a; at 1.5 cells each (the default) the two grids' staircases give
     different normals, twice that apart."""
-    from ehlfoam.thinfilm.model import _Operators, _touches
+    from ehlfoam.thinfilm.operators import Operators, touches
 
     def pull_field(cell, normal_length):
         prob = ball_problem(receding_meniscus="bretherton", cell=cell * A,
                             normal_length=normal_length)
         grid = Grid.build(prob)
-        ops = _Operators(prob, grid)
+        ops = Operators(prob, grid)
         X, Y = np.meshgrid(grid.x, grid.y)
         xr, yr = (X - Y) / np.sqrt(2), (X + Y) / np.sqrt(2)
         flooded = ((xr / (7 * A)) ** 2 + (yr / (4 * A)) ** 2 < 1) & ~grid.island
@@ -199,7 +200,7 @@ def test_a_normal_length_in_metres_gives_every_grid_the_same_pull():
         fine, fl_f, _ = pull_field(0.1, normal_length)
         fine_mean = 0.25 * (fine[0::2, 0::2] + fine[1::2, 0::2] + fine[0::2, 1::2]
                             + fine[1::2, 1::2])
-        edge = _touches(fl_c) & ~grid_c.island & (fl_c == fl_f[0::2, 0::2])
+        edge = touches(fl_c) & ~grid_c.island & (fl_c == fl_f[0::2, 0::2])
         excess = coarse[~grid_c.island].max() - 1.0
         apart[normal_length] = np.percentile(np.abs(coarse - fine_mean)[edge] / excess, 90)
     assert apart[0.6 * A] < 0.025
@@ -277,38 +278,8 @@ def test_bad_parameters_are_refused_by_name_and_range(key, value, words):
         ball_problem(**{key: value})
 
 
-def test_a_case_spec_becomes_the_same_problem():
-    """bench/thin_film_region.py reads the spec's contact, oil, wetting and supply."""
-    from bench.thin_film_region import problem_from_spec
-    from ehlfoam.spec.case import make_case_spec
-
-    spec = make_case_spec({"supply": {"mode": "layers", "disc_layer": 5e-6, "ball_layer": 3e-6,
-                                      "track_half_width": 2e-4, "initial_puddle": 6.0},
-                           "physics": {"contact_angle": 20.0}})
-    a = spec.a
-    prob = problem_from_spec(spec, ball_gap, 0.25, (-10.0, 18.0, 9.0), film_factor=2.0,
-                             receding="bretherton", normal_length=0.3)
-    assert prob.supply == pytest.approx(8e-6)
-    assert prob.track_half_width == pytest.approx(2e-4)
-    assert prob.initial_radius == pytest.approx(6 * a)
-    assert prob.island_radius == pytest.approx(spec.domain.island_radius * a)
-    assert prob.x_range == pytest.approx((-10 * a, 18 * a)) and prob.y_max == pytest.approx(9 * a)
-    assert prob.cell == pytest.approx(0.25 * a)
-    assert (prob.speed, prob.viscosity) == (spec.speed, spec.oil_viscosity)
-    assert (prob.contact_angle, prob.receding_meniscus) == (20.0, "bretherton")
-    assert prob.normal_length == pytest.approx(0.3 * a)
-    assert prob.film == pytest.approx(2 * landau_levich(spec.oil_viscosity, spec.speed,
-                                                        spec.physics.surface_tension))
-    flooded = make_case_spec({"supply": {"mode": "flooded"}})
-    prob = problem_from_spec(flooded, ball_gap, 0.25, (-10.0, 18.0, 9.0))
-    assert prob.supply == pytest.approx(ball_gap(-10 * flooded.a, 0.0))   # the whole inlet gap
-    with pytest.raises(ValueError, match="supply.mode = 'submerged'"):
-        problem_from_spec(make_case_spec({"supply": {"mode": "submerged"}}), ball_gap, 0.25,
-                          (-10.0, 18.0, 9.0))
-
-
 def test_a_saved_state_starts_a_run_where_it_left_off(tmp_path):
-    """bench/thin_film_region.py --start: a state written by a run, read back, starts the
+    """`ehlfoam thin-film --start`: a state written by a run, read back, starts the
     next one with the same oil in the same cells, on its grid or a finer one."""
     from ehlfoam.thinfilm.state import load_state, save_state
 
@@ -321,38 +292,6 @@ def test_a_saved_state_starts_a_run_where_it_left_off(tmp_path):
     finer = solve_thin_film(ball_problem(cell=0.2 * A), transits_max=0, start=start)
     assert finer.metrics(A)["oil_volume_m3"] == pytest.approx(sol.metrics(A)["oil_volume_m3"],
                                                               rel=0.05)
-
-
-def test_the_lateral_current_beside_the_rear_meniscus_is_read_off_the_pressure(tmp_path):
-    """bench/rear_currents.py on a thin-film state written by hand: a gap of 10 um, the region
-    flooded ahead of x = 8 a, a pressure falling along y at the rate that drives 0.3 u across
-    y (h^2 / (12 eta) dp/dy = -0.3 u). Beside the rear meniscus (x_r = 8 a) the gap-averaged
-    rms is 0.3 u over the flooded cells only, the Poiseuille profile's sqrt(6/5) times that;
-    a state without its pressure is refused by name."""
-    from bench.rear_currents import thin_film_currents
-    from ehlfoam.spec.case import make_case_spec
-
-    spec = make_case_spec({})
-    a, u, eta, gap = spec.a, spec.speed, spec.oil_viscosity, 10e-6
-    d = 0.25 * a
-    x = -4 * a + d * (np.arange(80) + 0.5)
-    y = d * (np.arange(24) + 0.5)
-    X, Y = np.meshgrid(x, y)
-    h = np.where(np.hypot(X, Y) < a, np.nan, gap)
-    flooded = (X < 8 * a) & ~np.isnan(h)
-    p = np.where(flooded, 0.3 * u * 12 * eta / gap**2 * (-Y), np.nan)
-    state = tmp_path / "state.npz"
-    np.savez(state, x=x, y=y, h=h, flooded=flooded, content=np.where(flooded, h, 0.0), p=p,
-             fill=np.zeros(h.shape))
-    res = thin_film_currents(state, spec, half_length=1.0, y_from=0.5, y_to=1.5)
-    assert res["rear_over_a"] == pytest.approx(8.0)
-    assert res["cells"] == 4 * 4                    # x in (7, 8) a, y in [0.5, 1.5) a
-    assert res["gap_averaged_rms_over_u"] == pytest.approx(0.3, rel=1e-9)
-    assert res["gap_averaged_median_abs_over_u"] == pytest.approx(0.3, rel=1e-9)
-    assert res["poiseuille_rms_over_u"] == pytest.approx(0.3 * np.sqrt(1.2), rel=1e-9)
-    np.savez(state, x=x, y=y, h=h, flooded=flooded, content=np.where(flooded, h, 0.0))
-    with pytest.raises(ValueError, match="holds no pressure"):
-        thin_film_currents(state, spec)
 
 
 def test_oil_fraction_at_reads_the_cell_holding_a_point_on_either_side_of_the_axis():

@@ -18,10 +18,10 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from ehlfoam._io import atomic_write_json, atomic_write_text
-
-from ehlfoam.batch.folder import CASES, LOCKS, SPEC_COPY, case_status, file_lock, read_metrics
-from ehlfoam.batch.spec import PlannedCase, load_plan
+from ehlfoam._io import atomic_write_text
+from ehlfoam.batch.folder import CASES, LOCKS, SPEC_COPY, case_status, file_lock, metrics_or_none
+from ehlfoam.batch.plan import PlannedCase, load_plan
+from ehlfoam.metrics.record import MetricsRecord, write_metrics
 
 #: How long a worker waits for a case still held by a stopping process (the solver's
 #: graceful stop takes up to ehlfoam.run.monitor.STOP_GRACE_S = 120 s).
@@ -91,10 +91,28 @@ def _clean_stale_builds(case: Path) -> None:
             shutil.rmtree(tmp, ignore_errors=True)
 
 
+#: What a build that failed before its case was written leaves in the case's folder.
+_FAILURE_FILES = {"metrics.json", "error.log"}
+
+
+def _clear_failed_build(case: Path) -> None:
+    """Remove the failure record of a build that never wrote its case (metrics.json and
+    error.log alone), so that the folder can take the case; anything else stays (and the
+    case writer refuses a folder that is not its own)."""
+    from ehlfoam.case.ownership import is_own_case
+
+    if not case.is_dir() or is_own_case(case):
+        return
+    entries = list(case.iterdir())
+    if entries and all(p.is_file() and p.name in _FAILURE_FILES for p in entries):
+        for p in entries:
+            p.unlink()
+
+
 def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> dict:
     """Build and run one case of the batch in this process (under its lock) and complete its
     metrics.json. A finished case is left alone; a failed one unless ``rerun_failed``."""
-    from ehlfoam.case.writer import write_case
+    from ehlfoam.case.writer import CaseBeingRun, write_case
     from ehlfoam.gap.source import precalc_dir
     from ehlfoam.run.monitor import CaseBusy, run_case
 
@@ -129,49 +147,62 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
             elif pc.ramp and pc.ramp.get("start_from"):   # the first step: a case or state
                 source = pc.ramp["start_from"]
             stage = "build"   # with mesh.follow, along the source's meniscus
-            write_case(following_spec(pc.spec, source), case, overwrite=True)
-            if source is not None:
+            _clear_failed_build(case)
+            seeded: list[dict] = []
+
+            def start(tmp: Path) -> None:   # in the built case, before it is put in place
+                nonlocal stage
                 stage = "ramp start"
-                seed = seed_case(case, source)
+                seeded.append(seed_case(tmp, source))
+
+            write_case(following_spec(pc.spec, source), case, overwrite=True,
+                       prepare=None if source is None else start)
+            seed = seeded[0] if seeded else None
             build_s = time.monotonic() - t0
             stage = "run"
             metrics = run_case(case)
-        except CaseBusy as err:
+        except (CaseBusy, CaseBeingRun) as err:   # an `ehlfoam run` outside the batch
             return {"id": case_id, "kind": "case", "status": "busy", "reason": str(err)}
         except Exception as err:  # noqa: BLE001 - recorded, the batch goes on
             metrics = _record_failure(case, case_id, stage, err, t0)
             return {"id": case_id, "kind": "case", "status": "failed",
-                    "reason": metrics["reason"]}
+                    "reason": metrics.reason}
         metrics = _complete_metrics(case, metrics, case_id, build_s, seed, t0)
-        return {"id": case_id, "kind": "case", "status": metrics.get("status"),
-                "reason": metrics.get("reason", "")}
+        return {"id": case_id, "kind": "case", "status": metrics.status,
+                "reason": metrics.reason or ""}
 
 
-def _record_failure(case: Path, case_id: str, stage: str, err: Exception, t0: float) -> dict:
+def _failed(old: MetricsRecord | None, **values) -> MetricsRecord:
+    """A ``failed`` record: ``old``'s keys but its status, then ``values``."""
+    kept = {k: v for k, v in old.to_json().items() if k != "status"} if old else {}
+    return MetricsRecord.model_validate({**kept, "status": "failed", **values})
+
+
+def _record_failure(case: Path, case_id: str, stage: str, err: Exception,
+                    t0: float) -> MetricsRecord:
     """metrics.json ``failed`` with the reason, and the traceback in error.log."""
     case.mkdir(parents=True, exist_ok=True)
     atomic_write_text(case / "error.log", traceback.format_exc())
-    old = read_metrics(case) or {}
-    keep = old if old.get("status") == "running" else {}   # this attempt's run only
-    metrics = {**{k: v for k, v in keep.items() if k != "status"}, "status": "failed",
-               "end_reason": f"{stage.replace(' ', '_')}_error",
-               "reason": f"{stage}: {oneline(err)}", "case_id": case_id,
-               "case_wall_s": time.monotonic() - t0}
-    atomic_write_json(case / "metrics.json", metrics)
+    old = metrics_or_none(case)
+    keep = old if old is not None and old.status == "running" else None   # this attempt's
+    metrics = _failed(keep, end_reason=f"{stage.replace(' ', '_')}_error",
+                      reason=f"{stage}: {oneline(err)}", case_id=case_id,
+                      case_wall_s=time.monotonic() - t0)
+    write_metrics(case, metrics)
     return metrics
 
 
-def _failure_reason(metrics: dict) -> str:
-    if metrics.get("status") != "failed":
+def _failure_reason(metrics: MetricsRecord) -> str:
+    if metrics.status != "failed":
         return ""
-    tail = [ln.strip() for ln in metrics.get("log_tail") or [] if ln.strip()]
+    tail = [ln.strip() for ln in metrics.log_tail or [] if ln.strip()]
     last = tail[-1] if tail else ""
-    return (f"solver {metrics.get('end_reason')} (exit code {metrics.get('solver_exit_code')})"
+    return (f"solver {metrics.end_reason} (exit code {metrics.solver_exit_code})"
             + (f": {last[:300]}" if last else ""))
 
 
-def _complete_metrics(case: Path, metrics: dict, case_id: str, build_s: float | None,
-                      seed: dict | None, t0: float) -> dict:
+def _complete_metrics(case: Path, metrics: MetricsRecord, case_id: str,
+                      build_s: float | None, seed: dict | None, t0: float) -> MetricsRecord:
     """Add the batch's keys to the run's metrics.json (written once, by its own worker)."""
     extra = {"case_id": case_id, "build_wall_s": build_s,
              "case_wall_s": time.monotonic() - t0}
@@ -181,16 +212,14 @@ def _complete_metrics(case: Path, metrics: dict, case_id: str, build_s: float | 
     reason = _failure_reason(metrics)
     if reason:
         extra["reason"] = reason
-    metrics = {**metrics, **extra}
-    atomic_write_json(case / "metrics.json", metrics)
+    metrics = metrics.updated(**extra)
+    write_metrics(case, metrics)
     return metrics
 
 
 def record_worker_lost(case: Path, case_id: str, reason: str) -> None:
     """metrics.json ``failed`` (``worker_lost``): the process running the case died."""
     case.mkdir(parents=True, exist_ok=True)
-    old = read_metrics(case) or {}
-    atomic_write_json(case / "metrics.json", {**{k: v for k, v in old.items() if k != "status"},
-                                              "status": "failed", "end_reason": "worker_lost",
-                                              "reason": reason, "case_id": case_id})
+    write_metrics(case, _failed(metrics_or_none(case), end_reason="worker_lost",
+                                reason=reason, case_id=case_id))
 

@@ -16,7 +16,6 @@ scheduler, or Slurm through dask-jobqueue); and what runs in a worker: :func:`ru
 
 from __future__ import annotations
 
-import ctypes
 import json
 import math
 import os
@@ -29,9 +28,8 @@ from pathlib import Path
 from typing import Any
 
 from ehlfoam.batch.case import ensure_precalc, execute_case
-from ehlfoam.batch.spec import SpecError
-
-PR_SET_PDEATHSIG = 1
+from ehlfoam.errors import SpecError
+from ehlfoam.foam.lifetime import set_parent_death_signal
 
 
 # =========================================================================== worker side
@@ -53,11 +51,7 @@ def _on_stop_signal(signum, frame) -> None:
 
 def _die_with_parent(parent: int) -> None:
     """SIGUSR1 when the parent dies (Linux prctl), and a watchdog thread as a backstop."""
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGUSR1), 0, 0, 0)
-    except (OSError, AttributeError):
-        pass
+    set_parent_death_signal(signal.SIGUSR1)
 
     def watch() -> None:
         while True:

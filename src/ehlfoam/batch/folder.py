@@ -3,12 +3,14 @@
 Layout of a batch folder (``runs/NAME/`` for ``runs/NAME.toml``)::
 
     batch.toml          verbatim copy of the batch spec
-    plan.json           the expanded plan: [{"id", "params", "ramp"}, ...]
+    plan.json           the expanded plan: [{"id", "params", "ramp"}, ...]; params: the case
+                        spec's dotted keys in SI (ehlfoam.batch.plan)
     cases/<id>/         one case each (ehlfoam.case.writer.write_case + ehlfoam.run.monitor.run_case):
                         metrics.json (the single source of truth), history.csv, log.interFoam
     results.csv         one row per planned case, rebuilt atomically from the metrics.json files
-                        (runs/batch_results.py)
-    regime/             regime-map PNGs and regime.json (runs/regime.py)
+                        (ehlfoam.batch.results)
+    regime/             regime.json: the regime analysis (ehlfoam.batch.regime), SI
+    report/             the batch report (ehlfoam.report), with the regime pictures
     locks/<id>.lock     held by the process that builds and runs the case
     batch.lock          held by the ``ehlfoam batch`` process
 """
@@ -16,12 +18,13 @@ Layout of a batch folder (``runs/NAME/`` for ``runs/NAME.toml``)::
 from __future__ import annotations
 
 import fcntl
-import json
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+
+from ehlfoam.case.ownership import lock_held
+from ehlfoam.metrics.record import MetricsRecord, read_metrics
 
 SPEC_COPY, PLAN, RESULTS, CASES, LOCKS = (
     "batch.toml", "plan.json", "results.csv", "cases", "locks")
@@ -60,24 +63,14 @@ def file_lock(path: Path, timeout: float = 0.0, shared: bool = False) -> Iterato
 
 def lock_is_held(path: Path) -> bool:
     """True if another process holds an flock on ``path`` (probe, released at once)."""
-    try:
-        fh = open(path)
-    except FileNotFoundError:
-        return False
-    try:
-        fcntl.flock(fh, fcntl.LOCK_SH | fcntl.LOCK_NB)
-        return False
-    except BlockingIOError:
-        return True
-    finally:
-        fh.close()
+    return lock_held(path)
 
 
-def read_metrics(case: Path) -> dict[str, Any] | None:
-    """The case's metrics.json, or None (absent or unreadable)."""
+def metrics_or_none(case: Path) -> MetricsRecord | None:
+    """The case's metrics record, or None (no metrics.json, or not a readable record)."""
     try:
-        return json.loads((case / "metrics.json").read_text())
-    except (FileNotFoundError, json.JSONDecodeError):
+        return read_metrics(case)
+    except (FileNotFoundError, ValueError):
         return None
 
 
@@ -86,14 +79,14 @@ def case_status(case: Path, live: bool = False) -> str:
 
     ``live``: this batch process has the case in flight (its lock is not probed then, so
     that a probe can never collide with the worker taking it)."""
-    m = read_metrics(case)
-    status = (m or {}).get("status")
+    m = metrics_or_none(case)
+    status = m.status if m else None
     if status in ("finished", "failed"):
         return status
     if live:
         return "running"
     if status == "running":
-        from ehlfoam.case.writer import META
+        from ehlfoam.case.geometry import META
 
         return "running" if lock_is_held(case / META / "run.lock") else "interrupted"
     return "interrupted" if status == "interrupted" else "pending"

@@ -1,10 +1,11 @@
 """Run a batch of cases: plan -> cases, on local processes or on Dask; resume; results.csv.
 
 The entry points (:func:`run_batch`, :func:`dry_run`) and their options. The parts:
-``batch_spec.py`` (the spec and the plan), ``batch_folder.py`` (the folder's layout, locks,
-a case's status), ``batch_case.py`` (build and run one case), ``batch_executors.py`` (local
-processes, Dask, Slurm; the worker side), ``batch_runner.py`` (scheduling the tasks),
-``batch_progress.py`` (the progress bar), ``batch_results.py`` (results.csv).
+``spec`` (the batch spec), ``plan`` (its cases), ``folder`` (the folder's layout, locks, a
+case's status), ``case`` (build and run one case), ``executors`` (local processes, Dask,
+Slurm; the worker side), ``runner`` (scheduling the tasks), ``progress`` (the progress bar),
+``results`` (results.csv), ``regime`` (the regime analysis). The report is made by the
+caller's ``report`` function (the batch sits below the reports).
 
 Rules:
 
@@ -24,7 +25,7 @@ Rules:
   (``status: failed``, ``reason``) and do not stop the batch; a failed ramp step leaves its
   successors pending.
 - **Ramps.** The steps of a ramp run one after the other, each from the previous step's final
-  fields (runs/ramp.py); ramps and sweep cases run in parallel.
+  fields (ehlfoam.seed.start); ramps and sweep cases run in parallel.
 - **Local executor** (default): a ``ProcessPoolExecutor`` (spawn) running at most
   ``cores // run.n_procs`` cases at once, longest first; the EHL precalcs of new contacts are
   solved first, each once (a file lock per contact guards the cache across processes).
@@ -50,7 +51,8 @@ from ehlfoam.batch.executors import DaskExecutor, LocalExecutor, cpu_budget, slu
 from ehlfoam.batch.folder import (BATCH_LOCK, CASES, LOCKS, PLAN, RESULTS, SPEC_COPY, STATUSES, batch_folder, case_status, file_lock)
 from ehlfoam.batch.progress import Progress
 from ehlfoam.batch.runner import BatchRunner
-from ehlfoam.batch.spec import PRECALC_CPU_S, BatchSpec, PlannedCase, est_cpu_s, load_plan
+from ehlfoam.batch.plan import PRECALC_CPU_S, PlannedCase, est_cpu_s, load_plan
+from ehlfoam.batch.spec import BatchSpec
 
 
 class BatchError(RuntimeError):
@@ -86,7 +88,7 @@ def _spec_diff(a: Any, b: Any, prefix: str = "") -> list[str]:
 
 def check_finished_specs(batch_dir: Path, plan: list[PlannedCase]) -> None:
     """A finished case must have been built from the spec the plan gives it now."""
-    from ehlfoam.case.writer import load_spec_of
+    from ehlfoam.case.geometry import load_spec_of
 
     for pc in plan:
         case = batch_dir / CASES / pc.id
@@ -114,10 +116,17 @@ class BatchOptions:
     rerun_failed: bool = False
     scheduler: str | None = None       # Dask scheduler address
     slurm: dict[str, Any] | None = None
-    client: Any = None                 # an existing distributed.Client (tests, benchmarks)
+    client: Any = None                 # an existing distributed.Client (tests, timings)
     quiet: bool = False
-    regime: bool = True
-    report: bool = True
+    regime: bool = True                # the regime analysis (regime/regime.json)
+    #: what reports the batch after its cases, called with the batch folder and the log
+    #: (``ehlfoam batch`` passes :func:`ehlfoam.report.after_batch`); None: no report
+    report: Callable[[Path, Callable[[str], None]], Any] | None = None
+
+    def __post_init__(self) -> None:
+        if self.report is not None and self.report is not False and not callable(self.report):
+            raise TypeError(f"BatchOptions.report = {self.report!r}: give the function that "
+                            f"reports a batch (ehlfoam.report.after_batch) or None")
 
 
 def _make_executor(opts: BatchOptions, plan: list[PlannedCase]):
@@ -151,25 +160,17 @@ def _write_inputs(batch_dir: Path, spec_path: Path, plan: list[PlannedCase]) -> 
 
 
 def _after(batch_dir: Path, rows: list[dict], opts: BatchOptions, log: Callable) -> None:
-    """Regime map, then the batch report (if the report package is there)."""
+    """The regime analysis, then the report (``opts.report``)."""
     if opts.regime:
         try:
             from ehlfoam.batch.regime import write_regime
 
-            summary = write_regime(batch_dir, rows)
-            for line in summary.get("summary", []):
-                log(f"regime: {line}")
+            write_regime(batch_dir, rows)
         except Exception as err:  # noqa: BLE001 - the results stay
             log(f"regime map failed: {oneline(err)}")
     if opts.report:
         try:
-            from ehlfoam.report import report_batch
-        except ImportError:
-            log("batch report: ehlfoam.report is not available yet (no report written)")
-            return
-        try:
-            out = report_batch(batch_dir)
-            log(f"batch report: {out if out else batch_dir}")
+            opts.report(batch_dir, log)
         except Exception as err:  # noqa: BLE001
             log(f"batch report failed: {oneline(err)}")
 

@@ -10,15 +10,16 @@ from pathlib import Path
 from typing import Any
 
 from ehlfoam._io import atomic_write_text
+from ehlfoam.metrics.record import MetricsRecord
 
-from ehlfoam.batch.folder import CASES, RESULTS, case_status, read_metrics
-from ehlfoam.batch.spec import PlannedCase
+from ehlfoam.batch.folder import CASES, RESULTS, case_status, metrics_or_none
+from ehlfoam.batch.plan import PARAM_KEYS, PlannedCase
 
 LOG = "log.interFoam"
 
-#: results.csv: these columns first, then every other scalar of metrics.json.
-FIXED_COLUMNS = ("case_id", "speed_mm_s", "temperature_C", "load_N", "supply", "disc_layer_um",
-                 "ball_layer_um", "resolution", "ramp", "ramp_step", "ramp_direction", "status",
+#: results.csv: these columns first (the case's parameters: the case spec's dotted keys in
+#: SI), then any other swept key, then every other scalar of the metrics record, by its key.
+FIXED_COLUMNS = ("case_id", *PARAM_KEYS, "ramp", "ramp_step", "ramp_direction", "status",
                  "end_reason", "reason", "state", "wall_s", "cells", "case_dir", "log")
 
 
@@ -39,7 +40,7 @@ def _cell(value: Any) -> str:
 def solver_log(case: Path) -> str:
     """The name of the case's solver log (log.interFoam, log.compressibleInterFoam)."""
     try:
-        from ehlfoam.case.writer import load_geometry
+        from ehlfoam.case.geometry import load_geometry
 
         return load_geometry(case).log_name
     except Exception:  # noqa: BLE001 - not built (yet), or an older geometry.json
@@ -50,10 +51,15 @@ def result_row(batch_dir: Path, pc: PlannedCase, live: bool = False,
                blocked: str = "") -> dict[str, Any]:
     """The results.csv row of a planned case (typed values)."""
     case = batch_dir / CASES / pc.id
-    m = read_metrics(case) or {}
+    m = metrics_or_none(case) or MetricsRecord()
     status = case_status(case, live)
     ramp = pc.ramp or {}
     reason = m.get("reason", "") if status in ("failed", "interrupted") else ""
+    end_reason = m.get("end_reason") if status != "pending" else None
+    if status == "interrupted" and m.status == "running":   # its lock is free: killed
+        end_reason = "monitor_killed"
+        reason = ("the process running it was killed before the run ended (metrics.json "
+                  "said running, its run lock was free); rebuilt on the next run")
     if status == "interrupted" and not reason:
         reason = "stopped before the end of its run (rebuilt on the next run)"
     if status == "pending" and blocked:
@@ -61,13 +67,14 @@ def result_row(batch_dir: Path, pc: PlannedCase, live: bool = False,
     log = solver_log(case)
     row = {"case_id": pc.id, **pc.params, "ramp": ramp.get("name"),
            "ramp_step": ramp.get("step"), "ramp_direction": ramp.get("direction"),
-           "status": status, "end_reason": m.get("end_reason") if status != "pending" else None,
+           "status": status, "end_reason": end_reason,
            "reason": reason, "state": m.get("state") if status == "finished" else None,
            "wall_s": m.get("wall_s"), "cells": m.get("cells"),
            "case_dir": f"{CASES}/{pc.id}",
            "log": f"{CASES}/{pc.id}/{log}" if (case / log).is_file() else None}
     if status in ("finished", "failed"):
-        row.update({k: v for k, v in m.items() if k not in row and _scalar(v)})
+        row.update({k: v for k, v in m.to_json().items()
+                    if k not in row and k != "schema_version" and _scalar(v)})
     return row
 
 

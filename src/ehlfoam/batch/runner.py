@@ -10,10 +10,12 @@ from pathlib import Path
 from typing import Any
 
 from ehlfoam.batch.case import oneline, precalc_cached, record_worker_lost
-from ehlfoam.batch.folder import CASES, LOCKS, STATUSES, case_status, file_lock, read_metrics
+from ehlfoam.batch.folder import CASES, LOCKS, STATUSES, case_status, file_lock, metrics_or_none
 from ehlfoam.batch.progress import Progress, sim_fraction
 from ehlfoam.batch.results import write_results
-from ehlfoam.batch.spec import PRECALC_CPU_S, PlannedCase, est_cpu_s
+from ehlfoam.batch.plan import PRECALC_CPU_S, PlannedCase, est_cpu_s
+from ehlfoam.metrics.record import MetricsRecord
+from ehlfoam.notices import NoticeTally
 
 POLL_S = 0.5
 
@@ -50,6 +52,7 @@ class BatchRunner:
         self.done_cost = 0.0
         self.outcome: dict[str, str] = {}
         self.retried: set[str] = set()
+        self.notices = NoticeTally(progress.log)   # each warning once per batch
         self._build_tasks()
 
     # ------------------------------------------------------------- the task graph
@@ -152,14 +155,14 @@ class BatchRunner:
             return
         case = self.batch_dir / CASES / task.key
         status = case_status(case)
-        m = read_metrics(case) or {}
+        m = metrics_or_none(case) or MetricsRecord()
         self.outcome[task.key] = status
         if status == "finished":
             wall = m.get("case_wall_s") or m.get("wall_s") or 0.0
             word = "kept" if result.get("skipped") else "finished"
             self.progress.log(f"{word:8s} {task.key}: state {m.get('state')}, "
-                              f"{m.get('end_reason')}, {wall:.0f} s"
-                              + (f"; warning: {m['warnings']}" if m.get("warnings") else ""))
+                              f"{m.get('end_reason')}, {wall:.0f} s")
+            self.notices.add(task.key, m.get("warnings"))
         else:
             reason = result.get("reason") or m.get("reason") or status
             self.progress.log(f"{status:8s} {task.key}: {reason}")
@@ -241,6 +244,8 @@ class BatchRunner:
                 self._refresh()
                 last_refresh = time.monotonic()
         self._refresh()
+        if summary := self.notices.summary():
+            self.progress.log(summary)
 
     def stop(self) -> None:
         """Ctrl-C / SIGTERM: stop the cases in flight (they write ``interrupted``), wait for

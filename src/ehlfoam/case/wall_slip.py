@@ -1,11 +1,11 @@
 """Navier slip on a moving wall, as v1912's ``directionMixed`` velocity condition.
 
-With no slip and a static contact angle the viscous stress at a moving contact line is
-singular and a volume-of-fluid method cuts it off at its cells: where the walls drive into
-the oil (the flooded region's front and sides) the line's apparent angle then depends on the
-cells (docs/cases.md, "The region's sides are moving contact lines"). A slip length lambda
-that the cells resolve removes the singularity at a length of the model's, not the mesh's:
-the wall's fluid moves with it but for lambda times the shear, u_s - U_w = lambda du/dn.
+With no slip and a static contact angle the viscous stress at a moving contact line is singular
+and a volume-of-fluid method cuts it off at its cells: where the walls drive into the oil (the
+flooded region's front and sides) the line's apparent angle then depends on the cells
+(docs/models/interface.md#the-contact-line-model-and-what-converges). A slip length lambda that
+the cells resolve removes the singularity at a length of the model's, not the mesh's: the
+wall's fluid moves with it but for lambda times the shear, u_s - U_w = lambda du/dn.
 
 v1912 has no Navier slip condition and nothing can be compiled here, but ``directionMixed``
 holds it on a fixed mesh: the normal part of the velocity fixed to the wall's (no flow
@@ -25,7 +25,7 @@ import numpy as np
 from foamlib import FoamFieldFile
 
 from ehlfoam.case.foam_lists import fill_placeholders, placeholder
-from ehlfoam.mesh.mesh import PolyMesh
+from ehlfoam.mesh import PolyMesh
 
 
 def wall_normals(mesh: PolyMesh, patch: str) -> np.ndarray:

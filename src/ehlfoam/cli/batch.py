@@ -4,8 +4,7 @@ Exit codes: 0 every planned case finished; 1 some case failed or is not finished
 input (bad spec, busy folder, a finished case with another spec; nothing built);
 130 interrupted (Ctrl-C / SIGTERM; re-run the command to resume).
 
-Registered in ``runs/cli.py`` by ``batch_cli.add_parser(sub)``; also runs on its own:
-``python -m ehlfoam.cli.batch SPEC [options]``.
+Also runs on its own: ``python -m ehlfoam.cli.batch SPEC [options]``.
 """
 
 from __future__ import annotations
@@ -15,7 +14,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-EXIT_OK, EXIT_FAILURE, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+from ehlfoam.cli.common import EXIT_BAD_INPUT, EXIT_OK, add_command, positive_int
 
 DESCRIPTION = (
     "Expand a batch spec (a base case spec plus sweeps over speed, temperature, load, supply "
@@ -24,29 +23,25 @@ DESCRIPTION = (
     "runs/NAME/results.csv, the regime map (runs/NAME/regime/) and the batch report. "
     "Re-running resumes: finished cases are kept, failed ones re-run only with "
     "--rerun-failed. Exit 1 if a case failed, 2 on bad input (nothing built).")
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value} (valid range >= 1)")
-    return value
+EXAMPLES = ("ehlfoam batch examples/batches/default.toml",
+            "ehlfoam batch examples/batches/default.toml --dry-run",
+            "ehlfoam batch examples/batches/regime.toml --out runs/regime --slurm "
+            "cores=16,memory=16GB,walltime=01:00:00,jobs=4")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    """The batch command's arguments (shared by the subcommand and the module's main)."""
+    """The batch command's arguments."""
     p.add_argument("spec", help="batch spec TOML (e.g. examples/batches/default.toml)")
     p.add_argument("--out", default=None,
-                   help="batch folder (default: runs/STEM/ in the working directory for STEM.toml)")
+                   help="batch folder (default: runs/STEM/ in the working directory for "
+                        "STEM.toml); its path may not hold whitespace, quotes, a backslash or "
+                        "any of *?[]{}$;<>|&` (OpenFOAM cannot take them)")
     p.add_argument("--rerun-failed", action="store_true",
                    help="re-run failed cases (finished cases are never recomputed)")
     size = p.add_mutually_exclusive_group()
-    size.add_argument("--jobs", type=_positive_int, default=None,
+    size.add_argument("--jobs", type=positive_int, default=None,
                       help="cases at once on this machine (each uses run.n_procs cores)")
-    size.add_argument("--cores", type=_positive_int, default=None,
+    size.add_argument("--cores", type=positive_int, default=None,
                       help="CPU budget on this machine (default: all cores); cases at once = "
                            "cores // run.n_procs")
     dask = p.add_mutually_exclusive_group()
@@ -66,12 +61,25 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Register ``ehlfoam batch``."""
-    p = subparsers.add_parser(
-        "batch", help="run a batch of cases (sweeps, speed ramps) and map the flow regimes",
-        description=DESCRIPTION)
+    p = add_command(
+        subparsers, "batch",
+        help="run a batch of cases (sweeps, speed ramps) and map the flow regimes",
+        description=DESCRIPTION, examples=EXAMPLES)
     add_arguments(p)
     p.set_defaults(func=cmd_batch)
     return p
+
+
+def check_batch_folder(spec: str, out: str | None, *, writes: bool = True) -> Path:
+    """The batch folder (``--out``, else runs/STEM/), checked before anything is built: a
+    path OpenFOAM can take (its cases are under it) and, with ``writes``, one that can be
+    written. Raises :class:`~ehlfoam.errors.SpecError` naming it, the path and why."""
+    from ehlfoam.batch.folder import batch_folder
+    from ehlfoam.paths import check_case_out
+
+    folder = batch_folder(Path(spec), Path(out) if out else None)
+    check_case_out(folder, "--out" if out else "batch folder", writes=writes)  # ids are safe
+    return folder
 
 
 def cmd_batch(args: argparse.Namespace) -> int:
@@ -80,7 +88,9 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
     from ehlfoam.batch.launch import BatchError, BatchOptions, dry_run, run_batch
     from ehlfoam.batch.executors import parse_slurm
+    from ehlfoam.report import after_batch
 
+    check_batch_folder(args.spec, args.out, writes=not args.dry_run)
     try:
         if args.dry_run:
             print(dry_run(args.spec, Path(args.out) if args.out else None))
@@ -89,7 +99,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
         opts = BatchOptions(out=Path(args.out) if args.out else None, jobs=args.jobs,
                             cores=args.cores, rerun_failed=args.rerun_failed,
                             scheduler=args.scheduler, slurm=slurm, quiet=args.quiet,
-                            regime=not args.no_report, report=not args.no_report)
+                            regime=not args.no_report,
+                            report=None if args.no_report else after_batch)
         outcome = run_batch(args.spec, opts)
     except (SpecError, BatchError) as err:
         print(f"ehlfoam batch: {err}", file=sys.stderr)
@@ -99,16 +110,14 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """``python -m ehlfoam.cli.batch SPEC [options]`` (the same as ``ehlfoam batch``)."""
-    parser = argparse.ArgumentParser(prog="ehlfoam batch", description=DESCRIPTION)
-    add_arguments(parser)
+    from ehlfoam.cli.failures import run_command
+
+    parser = add_parser(argparse.ArgumentParser(prog="ehlfoam").add_subparsers())
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:
         return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
-    try:
-        return cmd_batch(args)
-    except KeyboardInterrupt:
-        return EXIT_INTERRUPTED
+    return run_command(args, "batch", parser)
 
 
 if __name__ == "__main__":

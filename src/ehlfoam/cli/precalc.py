@@ -1,18 +1,22 @@
 """``ehlfoam precalc``: solve the EHL contact and write summary.json, solution.npz, precalc.png.
 
-Exit codes: 0 converged, 1 not converged (outputs written, ``converged: false``), 2 bad
-input (nothing written).
+Exit codes: 0 converged, 3 not converged (outputs written, ``converged: false``), 2 bad
+input: a bad value (NaN and inf too) or a --out that cannot be written, found before solving
+(nothing written).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
+from typing import TYPE_CHECKING
 
-from ehlfoam.errors import SpecError
+from ehlfoam.cli.common import EXIT_NOT_CONVERGED, EXIT_OK, add_command, removed_on_failure
 
-from ehlfoam.contact.spec import PrecalcSpec, load_spec, make_spec, valid_range
+if TYPE_CHECKING:
+    from ehlfoam.contact.spec import PrecalcSpec
 
 _OPTIONS = {
     # flag: (spec key, type, help with units)
@@ -33,34 +37,48 @@ _OPTIONS = {
 }
 
 
-def add_parser(subparsers) -> None:
+def add_parser(subparsers) -> argparse.ArgumentParser:
     """Register the ``precalc`` subcommand."""
-    p = subparsers.add_parser(
-        "precalc", help="solve the EHL contact (gap and film) of one operating point",
+    p = add_command(
+        subparsers, "precalc", help="solve the EHL contact (gap and film) of one operating point",
         description="Solve the isothermal EHL point contact (Reynolds + elastic deformation + "
                     "load balance) and write DIR/summary.json (SI units), DIR/solution.npz and "
-                    "DIR/precalc.png.")
+                    "DIR/precalc.png. Exit 3 if not converged (outputs written), 2 on bad "
+                    "input (nothing solved, nothing written).",
+        examples=["ehlfoam precalc --load 20 --speed 0.008 --temperature 40 --out precalc/u8",
+                  "ehlfoam precalc --speed 0.5 --grid 129 --out precalc/fast"])
     p.add_argument("spec_file", nargs="?", help="TOML spec (keys as the options, without --)")
-    for flag, (_, typ, help_) in _OPTIONS.items():
-        p.add_argument(flag, type=str if typ is not str else str, default=None, help=help_)
+    for flag, (_, _, help_) in _OPTIONS.items():
+        p.add_argument(flag, default=None, help=help_)   # converted by spec_from_args
     p.add_argument("--out", required=True, help="output folder")
     p.set_defaults(func=run)
+    return p
 
 
 def _convert(flag: str, raw: str | None):
+    from ehlfoam.contact.spec import valid_range
+    from ehlfoam.errors import SpecError
+
     if raw is None:
         return None
     key, typ, _ = _OPTIONS[flag]
+    kind = "an integer" if typ is int else "a number"
     try:
-        return typ(raw)
+        value = typ(raw)
     except ValueError:
-        kind = "an integer" if typ is int else "a number"
+        value = None
+    if value is None or (typ is float and not math.isfinite(value)):
         rng = valid_range(key)
-        raise SpecError(f"invalid input: {key} = {raw!r}: not {kind}"
+        finite = "a finite number" if value is not None else kind
+        raise SpecError(f"invalid input: {flag} {raw}: not {finite}"
                         + (f" ({rng})" if rng else "")) from None
+    return value
 
 
 def spec_from_args(args: argparse.Namespace) -> PrecalcSpec:
+    """The contact spec of the options (over the TOML spec file, if given)."""
+    from ehlfoam.contact.spec import load_spec, make_spec
+
     values = {_OPTIONS[f][0]: _convert(f, getattr(args, f[2:].replace("-", "_")))
               for f in _OPTIONS}
     if args.spec_file:
@@ -69,20 +87,22 @@ def spec_from_args(args: argparse.Namespace) -> PrecalcSpec:
 
 
 def run(args: argparse.Namespace) -> int:
-    try:
-        spec = spec_from_args(args)
-    except SpecError as err:
-        print(f"ehlfoam precalc: {err}", file=sys.stderr)
-        return 2
-    from ehlfoam.contact.outputs import write_all
+    """Check the spec and the output folder, solve, write the outputs, print the summary's
+    main numbers as one JSON line. Bad input raises (exit 2, nothing solved or written)."""
+    from ehlfoam.paths import check_output
+
+    spec = spec_from_args(args)
+    check_output(args.out, "--out")            # before solving: a precalc that cannot write
+    from ehlfoam.contact.outputs import write_all   # does not solve first
     from ehlfoam.contact.solver import solve
 
     result = solve(spec)
-    summary = write_all(result, args.out)
+    with removed_on_failure(args.out):
+        summary = write_all(result, args.out)
     keys = ("M", "L", "hc_m", "hmin_m", "p_max_Pa", "converged", "residual", "load_error",
             "grid", "wall_s")
     print(json.dumps({k: summary[k] for k in keys}))
     if not result.converged:
         print(f"ehlfoam precalc: NOT converged: {result.mg.failure}", file=sys.stderr)
-        return 1
-    return 0
+        return EXIT_NOT_CONVERGED
+    return EXIT_OK

@@ -13,7 +13,7 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ehlfoam._io import read_toml
-from ehlfoam.errors import SpecError, format_validation_error, range_text
+from ehlfoam.errors import SpecError, format_validation_error, range_text, unit_of
 from ehlfoam.contact.formulas import Contact
 from ehlfoam.contact.lubricant import OIL_TABLES, Lubricant, PressureLaws, lubricant_from_table, table_range
 
@@ -23,49 +23,69 @@ GRID_MIN, GRID_MAX = 65, 8193
 
 
 class PrecalcSpec(BaseModel):
-    """Operating conditions and numerical settings of one EHL precalc (SI units).
+    """Operating conditions and numerical settings of one EHL precalc (SI units; each field
+    states its unit in ``json_schema_extra["unit"]``)."""
 
-    Attributes:
-        load: normal load F [N].
-        speed: mean rolling speed u [m/s] (pure rolling: ball and disc both at u).
-        temperature: oil temperature [C] (selects eta0 and alpha of a tabulated oil).
-        lubricant: a tabulated oil name ("HVI60") or "custom" with eta0, alpha, rho0.
-        eta0: ambient viscosity [Pa s] (custom oil only).
-        alpha: pressure-viscosity coefficient [1/Pa] (custom oil only).
-        rho0: density [kg/m3] (custom oil only).
-        radius: ball radius R [m] (disc flat).
-        modulus: reduced modulus E' [Pa].
-        viscosity: "roelands" or "barus".
-        density: "dowson-higginson" or "incompressible".
-        cavitation: "complementarity" (p >= 0) or "twophase" (density drop below ambient,
-            zero-gradient outlet, domain x in [-2a, 6a], y in [-2a, 2a]).
-        twophase_p_scale: pressure scale p_s [Pa] of the two-phase density,
-            rho/rho0 = max(0, 1 + p/p_s) for gauge p < 0 (default p_ambient: density
-            proportional to absolute pressure).
-        grid: grid points along y (2^k + 1); None chooses from the Moes load parameter.
-        max_cycles: multigrid cycle limit.
-        tol_residual, tol_load: convergence tolerances (relative).
-    """
+    #: unknown keys refused, frozen, NaN and inf refused, strict types (no true or "25" for
+    #: a number, no 2.0 for an integer; an integer is a number)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-    load: float = Field(20.0, gt=0.0, le=1e5)
-    speed: float = Field(0.01, gt=0.0, le=100.0)
-    temperature: float = Field(40.0, ge=-40.0, le=300.0)
-    lubricant: str = "HVI60"
-    eta0: float | None = Field(None, gt=0.0, le=1e4)
-    alpha: float | None = Field(None, ge=0.0, le=1e-7)
-    rho0: float | None = Field(None, gt=0.0, le=1e4)
-    radius: float = Field(9.525e-3, gt=0.0, le=10.0)
-    modulus: float = Field(1.11e11, gt=0.0, le=1e13)
-    viscosity: Literal["roelands", "barus"] = "roelands"
-    density: Literal["dowson-higginson", "incompressible"] = "dowson-higginson"
-    cavitation: Literal["complementarity", "twophase"] = "complementarity"
-    twophase_p_scale: float = Field(P_AMBIENT_PA, gt=0.0, le=1e7)
-    grid: int | None = None
-    max_cycles: int = Field(100, ge=1, le=1000)
-    tol_residual: float = Field(3e-5, gt=0.0, lt=1.0)
-    tol_load: float = Field(3e-5, gt=0.0, lt=1.0)
+    load: float = Field(20.0, gt=0.0, le=1e5,
+                        description="Normal load F pressing the ball on the disc.",
+                        json_schema_extra={"unit": "N"})
+    speed: float = Field(0.01, gt=0.0, le=100.0,
+                         description="Mean rolling speed u; pure rolling: the ball and the disc "
+                                     "surfaces both move at u.",
+                         json_schema_extra={"unit": "m/s"})
+    temperature: float = Field(40.0, ge=-40.0, le=300.0,
+                               description="Oil temperature; selects eta0 and alpha of a "
+                                           "tabulated oil.",
+                               json_schema_extra={"unit": "C"})
+    lubricant: str = Field("HVI60",
+                           description='A tabulated oil ("HVI60") or "custom", which takes '
+                                       'eta0, alpha and rho0.')
+    eta0: float | None = Field(None, gt=0.0, le=1e4,
+                               description='Ambient viscosity of a custom oil (lubricant = '
+                                           '"custom" only).',
+                               json_schema_extra={"unit": "Pa s"})
+    alpha: float | None = Field(None, ge=0.0, le=1e-7,
+                                description='Pressure-viscosity coefficient of a custom oil '
+                                            '(lubricant = "custom" only).',
+                                json_schema_extra={"unit": "1/Pa"})
+    rho0: float | None = Field(None, gt=0.0, le=1e4,
+                               description='Density of a custom oil at ambient pressure '
+                                           '(lubricant = "custom" only).',
+                               json_schema_extra={"unit": "kg/m3"})
+    radius: float = Field(9.525e-3, gt=0.0, le=10.0,
+                          description="Ball radius R (the disc is flat).",
+                          json_schema_extra={"unit": "m"})
+    modulus: float = Field(1.11e11, gt=0.0, le=1e13,
+                           description="Reduced elastic modulus E' of the ball and the disc.",
+                           json_schema_extra={"unit": "Pa"})
+    viscosity: Literal["roelands", "barus"] = Field(
+        "roelands", description='The pressure-viscosity law: "roelands" or "barus".')
+    density: Literal["dowson-higginson", "incompressible"] = Field(
+        "dowson-higginson",
+        description='The pressure-density law: "dowson-higginson" or "incompressible".')
+    cavitation: Literal["complementarity", "twophase"] = Field(
+        "complementarity",
+        description='"complementarity": the pressure stays >= 0; "twophase": the density '
+                    'drops below ambient pressure, with a zero-gradient outlet, on the domain '
+                    'x in [-2a, 6a], y in [-2a, 2a].')
+    twophase_p_scale: float = Field(
+        P_AMBIENT_PA, gt=0.0, le=1e7,
+        description="Pressure scale p_s of the two-phase density, rho / rho0 = max(0, 1 + "
+                    "p / p_s) for gauge p < 0; the default, the ambient pressure, makes the "
+                    "density proportional to the absolute pressure.",
+        json_schema_extra={"unit": "Pa"})
+    grid: int | None = Field(None, description="Grid points along y, 2^k + 1 (65 to 8193); "
+                                               "none: chosen from the Moes load parameter.")
+    max_cycles: int = Field(100, ge=1, le=1000, description="Most multigrid cycles.")
+    tol_residual: float = Field(3e-5, gt=0.0, lt=1.0,
+                                description="Convergence tolerance of the Reynolds residual "
+                                            "(relative).")
+    tol_load: float = Field(3e-5, gt=0.0, lt=1.0,
+                            description="Convergence tolerance of the load balance (relative).")
 
     @field_validator("grid")
     @classmethod
@@ -127,16 +147,13 @@ class PrecalcSpec(BaseModel):
                             if self.cavitation == "twophase" else None)
 
 
-UNITS = {"load": "N", "speed": "m/s", "temperature": "C", "eta0": "Pa s", "alpha": "1/Pa",
-         "rho0": "kg/m3", "radius": "m", "modulus": "Pa", "twophase_p_scale": "Pa"}
-
-
 def valid_range(name: str) -> str:
-    """The valid range of a numeric spec field, from its constraints (e.g. '0 < load <= 1e+05 N')."""
+    """The valid range of a numeric spec field, from its constraints and unit (e.g.
+    'valid range 0 < load <= 1e+05 N')."""
     field = PrecalcSpec.model_fields.get(name)
     if field is None:
         return ""
-    return range_text(name, field, UNITS.get(name, ""))
+    return range_text(name, field, unit_of(field))
 
 
 def make_spec(**values) -> PrecalcSpec:
@@ -146,7 +163,7 @@ def make_spec(**values) -> PrecalcSpec:
         return PrecalcSpec(**values)
     except ValidationError as err:
         raise SpecError("invalid input: "
-                        + format_validation_error(err, PrecalcSpec, units=UNITS)) from None
+                        + format_validation_error(err, PrecalcSpec)) from None
 
 
 def load_spec(path: str | Path, **overrides) -> PrecalcSpec:

@@ -25,8 +25,13 @@ Every OpenFOAM application (blockMesh, interFoam, ...) is started through a
     script that sources an OpenFOAM bashrc and execs its arguments); the
     command is ``PREFIX... APP args``, environment unchanged.
 
-Not covered yet: parallel runs (the embedded runtime's mpirun cannot be
-driven through the loader; it needs a chroot, see the field notes).
+Parallel runs: :meth:`FoamRuntime.mpi_command` (the embedded runtime's mpirun
+cannot be driven through the loader; it runs in a chroot of the runtime).
+
+Every process started here dies with the thread that started it
+(:mod:`ehlfoam.foam.lifetime`: Linux's parent-death signal), and an embedded
+parallel run lives in a PID namespace of its own, so that all its ranks die
+with it: a SIGKILL of ``ehlfoam run`` leaves no solver behind.
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ import os
 import re
 import shlex
 import shutil
+import signal
 import subprocess
 import tempfile
 from collections.abc import Mapping, Sequence
@@ -43,6 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+from ehlfoam.foam.lifetime import die_with_parent
 from ehlfoam.paths import cache_dir
 
 __all__ = [
@@ -211,9 +218,13 @@ class FoamRuntime:
         cores counted from the first, for every mpirun alike, so cases run side by side (a
         batch, ``--jobs``) would share those cores and leave the others idle.
         embedded: Debian 13's mpirun cannot be driven through the loader, so the run happens
-        in a chroot of the runtime, in a private mount namespace (``unshare -m``) where the
-        case is bind-mounted at ``/mnt``; the mounts vanish with the process. Needs root.
-        ``case`` may be relative to the process's working folder (e.g. "." in a script).
+        in a chroot of the runtime, in a private mount namespace where the case is
+        bind-mounted at ``/mnt`` (the mounts vanish with the process) and a PID namespace of
+        its own (``unshare --mount --pid --fork --kill-child``): when ``unshare`` dies, however
+        it dies, the kernel kills every process of the run, mpirun's daemon and ranks
+        included. Its ``/tmp`` is a private tmpfs (mpirun's session folder, named after its
+        pid, which is 1 in every run, vanishes with it). Needs root. ``case`` may be relative to the process's working folder (e.g.
+        "." in a script).
         """
         if n_procs < 2:
             raise FoamConfigError(f"n_procs = {n_procs}: an MPI run needs at least 2 ranks")
@@ -232,10 +243,12 @@ class FoamRuntime:
                             "-parallel"])
         script = (f"mount --bind {shlex.quote(str(case))} {shlex.quote(str(root / 'mnt'))} && "
                   f"mount -t proc proc {shlex.quote(str(root / 'proc'))} && "
+                  f"mount -t tmpfs tmpfs {shlex.quote(str(root / 'tmp'))} && "
                   f"exec chroot {shlex.quote(str(root))} env -i PATH=/usr/bin:/bin HOME=/root "
                   f"WM_PROJECT_DIR=/usr/share/openfoam {allow} "
                   f"sh -c {shlex.quote('cd /mnt && exec ' + inner)}")
-        return ["unshare", "-m", "sh", "-c", script]
+        return ["unshare", "--mount", "--pid", "--fork", "--kill-child=SIGKILL",
+                "sh", "-c", script]
 
     def command_prefix(self) -> str:
         """The command as text, with ``<app>`` for the application (for display)."""
@@ -304,18 +317,27 @@ class FoamRuntime:
         cwd: str | os.PathLike[str] = ".",
         log_path: str | os.PathLike[str] = "log",
         n_procs: int = 1,
+        keep_fds: Sequence[int] = (),
     ) -> subprocess.Popen:
         """Start ``app args`` in the case folder ``cwd`` without waiting, stdout and stderr
         to ``log_path`` (relative to ``cwd``); on ``n_procs`` MPI ranks (decomposed case)
-        when n_procs > 1. The caller waits for or stops the process."""
+        when n_procs > 1. The caller waits for or stops the process.
+
+        The process dies with the calling thread (parent-death signal: SIGKILL, or SIGTERM
+        for the user's own mpirun, which then stops its ranks; an embedded parallel run's
+        ranks die with its PID namespace). ``keep_fds`` are handed to it open (e.g. the
+        case's run lock, which then stays held while the solver lives)."""
         case = self._checked_case(app, cwd)
         argv = self.command(app, *args) if n_procs < 2 else self.mpi_command(app, n_procs, case,
                                                                              *args)
+        death = signal.SIGTERM if n_procs > 1 and self.kind != "embedded" else signal.SIGKILL
         log = case / log_path
         with open(log, "w", encoding="utf-8", errors="replace") as fh:
             try:
                 return subprocess.Popen(argv, cwd=case, env=self.env(), stdout=fh,
-                                        stderr=subprocess.STDOUT, start_new_session=True)
+                                        stderr=subprocess.STDOUT, start_new_session=True,
+                                        pass_fds=tuple(keep_fds),
+                                        preexec_fn=die_with_parent(death))
             except FileNotFoundError as exc:
                 raise FoamError(f"{app}: cannot start {argv[0]!r} ({exc.strerror}); "
                                 f"runtime {self.kind}; case {case}") from exc
@@ -347,12 +369,13 @@ class FoamRuntime:
                 with open(log, "w", encoding="utf-8", errors="replace") as fh:
                     proc = subprocess.run(argv, cwd=case, env=self.env(), stdout=fh,
                                           stderr=subprocess.STDOUT, timeout=timeout,
-                                          check=False)
+                                          check=False, preexec_fn=die_with_parent())
                 output = log.read_text(encoding="utf-8", errors="replace")
             else:
                 proc = subprocess.run(argv, cwd=case, env=self.env(), stdout=subprocess.PIPE,
                                       stderr=subprocess.STDOUT, timeout=timeout, check=False,
-                                      text=True, errors="replace")
+                                      text=True, errors="replace",
+                                      preexec_fn=die_with_parent())
                 output = proc.stdout or ""
         except FileNotFoundError as exc:
             raise FoamError(f"{app}: cannot start {argv[0]!r} ({exc.strerror}); "

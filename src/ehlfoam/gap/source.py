@@ -1,4 +1,5 @@
-"""The deformed gap a case is built on: an ``ehl_precalc`` solution, solved once per contact.
+"""The deformed gap a case is built on: an EHL precalc solution (:mod:`ehlfoam.contact`),
+solved once per contact.
 
 Solutions are cached per machine under ``$EHLFOAM_CACHE/precalc/<hash of the contact spec>``
 (the same cache folder as the OpenFOAM runtime), so a batch of cases that share a contact

@@ -12,9 +12,9 @@ metric's own jitter (twice the standard deviation of its last writes) say nothin
 noise"), and an order outside :data:`ASYMPTOTIC_ORDER` says the meshes are not in the
 asymptotic range, where neither the extrapolation nor the index holds.
 
-Used by the batch report (a batch that sweeps ``resolution``) and ``bench/mesh_convergence.py``.
-:func:`rest_value` reads the value a metric comes to rest at on one mesh from runs that have
-not got there yet (``bench/rest_value.py``), for meshes too dear to run to rest.
+Used by the batch report (a batch that sweeps ``resolution``). :func:`rest_value` reads the
+value a metric comes to rest at on one mesh from runs that have not got there yet, for meshes
+too dear to run to rest.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ehlfoam.case.writer import load_geometry, load_spec_of
+from ehlfoam.case.geometry import load_geometry, load_spec_of
 
 #: The flow-pattern metrics read over the meshes (metrics.json / history.csv keys).
 METRICS = ("inlet_meniscus_distance_over_a", "flooded_width_over_a", "flooded_length_over_a",

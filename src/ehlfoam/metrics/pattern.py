@@ -12,7 +12,7 @@ nor gas. The domain is the rectangle ``x_min <= x <= x_max`` and
 
 Two steps:
 
-:func:`raster`
+:func:`raster` (:mod:`ehlfoam.metrics.raster`)
     resamples the field onto a regular grid of the full domain (linear
     interpolation on the Delaunay triangulation of the cell centres, nearest
     centre outside their convex hull), island pixels flagged.
@@ -27,245 +27,36 @@ Two steps:
     around the contact; gas at the rim, if any, is an enclosed bubble).
     State II: outer air reaches the rim (an open wake, or a starved inlet).
 
-Inside, everything is SI; the lengths returned are ratios to ``a``.
+Inside, everything is SI; the lengths returned are ratios to ``a``, under the keys of the
+metrics record (:class:`ehlfoam.metrics.record.MetricsRecord`).
 :func:`meniscus_contours` gives the ``alpha = threshold`` lines for plots.
 """
 
 from __future__ import annotations
 
-import functools
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from scipy import ndimage
-from scipy.spatial import QhullError
 
+from ehlfoam.metrics.raster import Geometry, Raster, check_threshold, raster
+
+#: Geometry, Raster and raster are re-exported: a caller of the metrics needs them.
 __all__ = [
     "Geometry",
     "Raster",
+    "advancing_front",
+    "bubble_mask",
+    "flooded_widths_at",
     "flow_pattern",
     "flow_pattern_from_raster",
-    "bubble_mask",
     "meniscus_contours",
     "raster",
 ]
 
-#: Default raster spacing as a fraction of the contact radius ``a``.
-DEFAULT_CELL_OVER_A = 1.0 / 20.0
-#: Largest raster accepted (pixels), to refuse a ``cell`` far too small.
-MAX_PIXELS = 20_000_000
-#: alpha values further than this outside [0, 1] are refused (not a fraction).
-ALPHA_TOLERANCE = 0.5
-#: Relative slack on the domain rectangle when checking the cell centres.
-DOMAIN_SLACK = 0.01
-
 _FOUR = ndimage.generate_binary_structure(2, 1)
 _EIGHT = ndimage.generate_binary_structure(2, 2)
-
-
-@dataclass(frozen=True)
-class Geometry:
-    """The domain around the contact, all lengths in metres.
-
-    ``a``: Hertzian contact radius; ``island_radius``: radius of the mesh's
-    hole at the origin (``>= a``); ``x_min < -island_radius`` and
-    ``x_max > island_radius``: inlet and outlet ends; ``y_max >
-    island_radius``: the side edge(s); ``symmetric``: the mesh covers
-    ``y >= 0`` only (mirrored for the analysis), else ``|y| <= y_max``.
-    """
-
-    a: float
-    island_radius: float
-    x_min: float
-    x_max: float
-    y_max: float
-    symmetric: bool = True
-
-    def __post_init__(self) -> None:
-        for name in ("a", "island_radius", "x_min", "x_max", "y_max"):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
-                raise ValueError(f"{name}: must be a finite number, got {value!r}")
-        if self.a <= 0:
-            raise ValueError(f"a: must be > 0, got {self.a!r}")
-        if self.island_radius < self.a:
-            raise ValueError(f"island_radius: must be >= a ({self.a!r}), got {self.island_radius!r}")
-        if self.x_min >= -self.island_radius:
-            raise ValueError(f"x_min: must be < -island_radius, got {self.x_min!r}")
-        if self.x_max <= self.island_radius:
-            raise ValueError(f"x_max: must be > island_radius, got {self.x_max!r}")
-        if self.y_max <= self.island_radius:
-            raise ValueError(f"y_max: must be > island_radius, got {self.y_max!r}")
-
-    @property
-    def y_min(self) -> float:
-        """Lower y edge of the mesh: 0 for a half domain, else ``-y_max``."""
-        return 0.0 if self.symmetric else -self.y_max
-
-
-@dataclass(frozen=True, eq=False)
-class Raster:
-    """The field on a regular grid of the full (mirrored) domain.
-
-    ``x`` (nx,) and ``y`` (ny,) are the pixel centres [m], ascending; the grid
-    includes the domain edges and the row ``y = 0``. ``alpha`` (ny, nx) is
-    clipped to [0, 1] and NaN on the island; ``island`` (ny, nx) flags the
-    pixels with ``x^2 + y^2 <= island_radius^2``.
-    """
-
-    x: np.ndarray
-    y: np.ndarray
-    alpha: np.ndarray
-    island: np.ndarray
-    geom: Geometry
-
-    @property
-    def dx(self) -> float:
-        """Pixel spacing along x [m]."""
-        return float(self.x[1] - self.x[0])
-
-    @property
-    def dy(self) -> float:
-        """Pixel spacing along y [m]."""
-        return float(self.y[1] - self.y[0])
-
-    @property
-    def axis_row(self) -> int:
-        """Index of the row ``y = 0``."""
-        return int(np.argmin(np.abs(self.y)))
-
-    def oil(self, threshold: float = 0.5) -> np.ndarray:
-        """Oil pixels: ``alpha >= threshold`` outside the island."""
-        return ~self.island & (np.nan_to_num(self.alpha, nan=0.0) >= threshold)
-
-    def gas(self, threshold: float = 0.5) -> np.ndarray:
-        """Gas pixels: ``alpha < threshold`` outside the island."""
-        return ~self.island & (np.nan_to_num(self.alpha, nan=1.0) < threshold)
-
-
-# --------------------------------------------------------------------------
-# input checks
-
-
-def _as_1d(name: str, values: Any) -> np.ndarray:
-    arr = np.asarray(values, dtype=float)
-    if arr.ndim != 1:
-        raise ValueError(f"{name}: must be one-dimensional, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name}: contains non-finite values")
-    return arr
-
-
-def _check_threshold(threshold: float) -> float:
-    if not isinstance(threshold, (int, float, np.integer, np.floating)) or not 0.0 < threshold < 1.0:
-        raise ValueError(f"threshold: must be in (0, 1), got {threshold!r}")
-    return float(threshold)
-
-
-def _check_inputs(x: Any, y: Any, alpha: Any, geom: Geometry) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Validate the cell-centre data; returns float arrays, alpha clipped to [0, 1]."""
-    if not isinstance(geom, Geometry):
-        raise ValueError(f"geom: must be a Geometry, got {type(geom).__name__}")
-    x, y, alpha = _as_1d("x", x), _as_1d("y", y), _as_1d("alpha", alpha)
-    if len(y) != len(x):
-        raise ValueError(f"y: length {len(y)} differs from x's {len(x)}")
-    if len(alpha) != len(x):
-        raise ValueError(f"alpha: length {len(alpha)} differs from x's {len(x)}")
-    if len(x) < 3:
-        raise ValueError(f"x: at least 3 cell centres needed, got {len(x)}")
-    if alpha.min() < -ALPHA_TOLERANCE or alpha.max() > 1.0 + ALPHA_TOLERANCE:
-        raise ValueError(
-            f"alpha: values in [{alpha.min():g}, {alpha.max():g}] are not a volume fraction")
-    slack_x = DOMAIN_SLACK * (geom.x_max - geom.x_min)
-    slack_y = DOMAIN_SLACK * geom.y_max
-    if x.min() < geom.x_min - slack_x or x.max() > geom.x_max + slack_x:
-        raise ValueError(
-            f"x: centres span [{x.min():g}, {x.max():g}] m, outside the domain "
-            f"[{geom.x_min:g}, {geom.x_max:g}] m (units?)")
-    if y.min() < geom.y_min - slack_y or y.max() > geom.y_max + slack_y:
-        raise ValueError(
-            f"y: centres span [{y.min():g}, {y.max():g}] m, outside the domain "
-            f"[{geom.y_min:g}, {geom.y_max:g}] m (symmetric={geom.symmetric}; units?)")
-    return x, y, np.clip(alpha, 0.0, 1.0)
-
-
-# --------------------------------------------------------------------------
-# resampling
-
-
-def _grid(geom: Geometry, cell: float) -> tuple[np.ndarray, np.ndarray]:
-    """Pixel centres spanning the full domain, edges and ``y = 0`` included."""
-    nx = max(2, int(round((geom.x_max - geom.x_min) / cell)) + 1)
-    half = max(1, int(round(geom.y_max / cell)))
-    if nx * (2 * half + 1) > MAX_PIXELS:
-        raise ValueError(f"cell: {cell:g} m gives more than {MAX_PIXELS} pixels")
-    xs = np.linspace(geom.x_min, geom.x_max, nx)
-    ys = np.linspace(-geom.y_max, geom.y_max, 2 * half + 1)
-    ys[half] = 0.0
-    return xs, ys
-
-
-@functools.lru_cache(maxsize=8)
-def _resampler(points_b: bytes, n: int, xs_b: bytes, ys_b: bytes) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices (k, 3) and weights (k, 3) that interpolate values at the points linearly onto
-    the grid (Delaunay triangulation; pixels outside the hull take the nearest point). Cached:
-    a case's cell centres never change, so the triangulation is built once per mesh."""
-    from scipy.spatial import Delaunay, cKDTree
-
-    points = np.frombuffer(points_b).reshape(n, 2)
-    gx, gy = np.meshgrid(np.frombuffer(xs_b), np.frombuffer(ys_b))
-    grid = np.column_stack([gx.ravel(), gy.ravel()])
-    try:
-        tri = Delaunay(points)
-    except QhullError as exc:
-        raise ValueError(f"x, y: the cell centres cannot be triangulated ({exc})") from None
-    simplex = tri.find_simplex(grid)
-    inside = simplex >= 0
-    vertices = np.zeros((len(grid), 3), dtype=np.int64)
-    weights = np.zeros((len(grid), 3))
-    T = tri.transform[simplex[inside]]
-    b = np.einsum("ijk,ik->ij", T[:, :2], grid[inside] - T[:, 2])
-    vertices[inside] = tri.simplices[simplex[inside]]
-    weights[inside] = np.column_stack([b, 1.0 - b.sum(axis=1)])
-    if (~inside).any():
-        _, nearest = cKDTree(points).query(grid[~inside])
-        vertices[~inside, 0] = nearest
-        weights[~inside, 0] = 1.0
-    return vertices, weights
-
-
-def raster(x: Any, y: Any, alpha: Any, geom: Geometry, cell: float | None = None) -> Raster:
-    """Resample ``alpha`` at cell centres ``(x, y)`` onto a regular full-domain grid.
-
-    ``cell`` is the pixel size [m] (default ``a/20``; the spacing is adjusted
-    so the grid ends on the domain edges). A half domain is mirrored
-    (``y -> -y``) before the interpolation. Linear interpolation on the
-    Delaunay triangulation of the centres; pixels outside their convex hull
-    (next to the domain edges) take the nearest centre's value. alpha is
-    clipped to [0, 1]; island pixels are NaN.
-
-    Raises ValueError (naming the parameter) on malformed input.
-    """
-    x, y, alpha = _check_inputs(x, y, alpha, geom)
-    if cell is None:
-        cell = DEFAULT_CELL_OVER_A * geom.a
-    if not isinstance(cell, (int, float, np.integer, np.floating)) or not math.isfinite(cell) or cell <= 0:
-        raise ValueError(f"cell: must be a positive finite length, got {cell!r}")
-    if geom.symmetric:
-        upper = y > 0.0
-        x, y, alpha = (np.concatenate([x, x[upper]]), np.concatenate([y, -y[upper]]),
-                       np.concatenate([alpha, alpha[upper]]))
-    xs, ys = _grid(geom, float(cell))
-    gx, gy = np.meshgrid(xs, ys)
-    points = np.column_stack([x, y])
-    vertices, weights = _resampler(points.tobytes(), len(points), xs.tobytes(), ys.tobytes())
-    values = np.einsum("ij,ij->i", alpha[vertices], weights).reshape(gx.shape)
-    island = gx**2 + gy**2 <= geom.island_radius**2
-    values = np.clip(values, 0.0, 1.0)
-    values[island] = np.nan
-    return Raster(x=xs, y=ys, alpha=values, island=island, geom=geom)
 
 
 # --------------------------------------------------------------------------
@@ -430,14 +221,15 @@ def advancing_front(r: Raster, track_half_width: float, threshold: float = 0.5) 
     """Points (x, y) [m], shape (n, 2), of the flooded region's edge that the walls, rolling
     along +x, run into from dry ground: flooded pixels whose upstream neighbour is neither
     flooded nor island, off the supply track (|y| > ``track_half_width`` [m]). There the oil
-    meets the walls in contact lines advancing onto dry walls (docs/cases.md, "The region's
-    sides are moving contact lines"). Empty without a flooded region."""
+    meets the walls in contact lines advancing onto dry walls
+    (docs/models/interface.md#the-contact-line-model-and-what-converges). Empty without a
+    flooded region."""
     if not isinstance(r, Raster):
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
     if not (math.isfinite(track_half_width) and track_half_width >= 0):
         raise ValueError(f"track_half_width: must be a finite length >= 0 m, got "
                          f"{track_half_width!r}")
-    flooded = _flooded(r.oil(_check_threshold(threshold)), _rim_mask(r.island))
+    flooded = _flooded(r.oil(check_threshold(threshold)), _rim_mask(r.island))
     behind = np.zeros_like(flooded)                # the pixel upstream is flooded or island
     behind[:, 1:] = flooded[:, :-1] | r.island[:, :-1]
     behind[:, 0] = True                            # the domain's upstream edge: not known
@@ -448,7 +240,7 @@ def advancing_front(r: Raster, track_half_width: float, threshold: float = 0.5) 
 
 def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any]:
     """Flow-pattern metrics of a :class:`Raster`; see :func:`flow_pattern`."""
-    threshold = _check_threshold(threshold)
+    threshold = check_threshold(threshold)
     if not isinstance(r, Raster):
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
     a = r.geom.a
@@ -566,7 +358,7 @@ def flow_pattern(x: Any, y: Any, alpha: Any, geom: Geometry, threshold: float = 
         area fraction with ``alpha >= threshold`` and mean alpha, island
         excluded.
     """
-    threshold = _check_threshold(threshold)
+    threshold = check_threshold(threshold)
     return flow_pattern_from_raster(raster(x, y, alpha, geom, cell), threshold)
 
 
@@ -577,7 +369,7 @@ def meniscus_contours(r: Raster, threshold: float = 0.5) -> list[np.ndarray]:
     """
     import contourpy
 
-    threshold = _check_threshold(threshold)
+    threshold = check_threshold(threshold)
     if not isinstance(r, Raster):
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
     z = np.ma.masked_array(np.nan_to_num(r.alpha, nan=0.0), mask=r.island)
@@ -591,8 +383,9 @@ def flooded_widths_at(r: Raster, x_stations: Any, threshold: float = 0.5) -> lis
     end at the interpolated ``alpha = threshold`` crossing (as ``flooded_width_over_a``,
     which is their largest over all x); None where the region does not reach that column.
     The outline behind the widest point (the rear shoulders) moves with the mesh where the
-    widest point does not (docs/cases.md)."""
-    threshold = _check_threshold(threshold)
+    widest point does not
+    (docs/models/interface.md#the-contact-line-model-and-what-converges)."""
+    threshold = check_threshold(threshold)
     if not isinstance(r, Raster):
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
     oil, gas = r.oil(threshold), r.gas(threshold)

@@ -2,8 +2,10 @@
 
     report_case(case_dir) -> CASE/report/index.html
     report_batch(batch_dir) -> BATCH/report/index.html
+    after_batch(batch_dir, log) -> the regime map's lines in the log, then report_batch
     report(dir)            -> whichever ``dir`` is
-    add_parser(subparsers) -> registers ``ehlfoam report DIR``
+
+``ehlfoam report DIR`` (ehlfoam.cli.report) is its command line.
 
 Everything renders off-screen (pyvista reads the case with its OpenFOAM reader and cuts
 it; matplotlib's Agg canvas draws): no X server, no ParaView.
@@ -16,7 +18,7 @@ from pathlib import Path
 
 from ehlfoam.report.case_report import report_case
 
-__all__ = ["add_parser", "is_batch", "is_case", "report", "report_batch", "report_case"]
+__all__ = ["after_batch", "is_batch", "is_case", "report", "report_batch", "report_case"]
 
 
 def is_case(path: str | os.PathLike) -> bool:
@@ -39,6 +41,14 @@ def report_batch(batch_dir: str | os.PathLike, **kwargs) -> Path:
     return _report_batch(batch_dir, **kwargs)
 
 
+def after_batch(batch_dir: str | os.PathLike, log) -> Path:
+    """What ``ehlfoam batch`` reports after its cases; see
+    :func:`ehlfoam.report.batch.after_batch`."""
+    from ehlfoam.report.batch import after_batch as _after_batch
+
+    return _after_batch(batch_dir, log)
+
+
 def report(path: str | os.PathLike, **kwargs) -> Path:
     """The report of a case or a batch folder (detected); returns the index.html path.
     Raises FileNotFoundError when ``path`` is not a folder, ValueError when it is neither."""
@@ -52,9 +62,3 @@ def report(path: str | os.PathLike, **kwargs) -> Path:
     raise ValueError(f"{p}: neither a case (ehlfoam/geometry.json, system/controlDict) nor "
                      f"a batch (plan.json, results.csv, cases/)")
 
-
-def add_parser(subparsers):
-    """Register ``report`` on an argparse subparsers object (see runs/cli.py)."""
-    from ehlfoam.report.cli import add_parser as _add
-
-    return _add(subparsers)

@@ -11,7 +11,6 @@ from __future__ import annotations
 import csv
 import dataclasses
 import json
-import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -20,7 +19,13 @@ from typing import Any
 
 import numpy as np
 
-from ehlfoam.case.writer import META, CaseGeometry
+from ehlfoam.case.geometry import META, CaseGeometry
+from ehlfoam.case.ownership import run_lock_held
+from ehlfoam.metrics.record import read_metrics
+from ehlfoam.run.history import history_columns, read_history
+
+__all__ = ["CaseInfo", "find_log", "history_columns", "load_case", "load_geometry_tolerant",
+           "log_header", "read_history", "tail_lines"]
 
 #: Lines of the solver log shown for a case that did not finish.
 LOG_TAIL_LINES = 30
@@ -88,6 +93,18 @@ def _read_json(path: Path, problems: list[str]) -> dict | None:
         return None
 
 
+def _read_metrics(case: Path, problems: list[str]) -> dict | None:
+    """The case's metrics record as metrics.json data (an older file's keys mapped to the
+    current ones), or None."""
+    try:
+        return read_metrics(case).to_json()
+    except FileNotFoundError:
+        return None
+    except ValueError as exc:
+        problems.append(f"metrics.json: unreadable ({' '.join(str(exc).split())[:300]})")
+        return None
+
+
 def load_geometry_tolerant(case: Path, problems: list[str]) -> CaseGeometry | None:
     """The case's :class:`CaseGeometry`; keys unknown to this version are ignored."""
     data = _read_json(case / META / "geometry.json", problems)
@@ -113,41 +130,6 @@ def _load_spec(case: Path, problems: list[str]) -> tuple[Any, dict]:
     except Exception as exc:  # a spec written by another version: show the raw values
         problems.append(f"ehlfoam/spec.json does not validate here ({type(exc).__name__})")
         return None, raw
-
-
-_FLAGS = {"True": True, "False": False}
-
-
-def read_history(path: Path) -> dict[str, np.ndarray] | None:
-    """history.csv as columns: floats (NaN for empty cells), ``state`` as text, and the
-    flags written as True/False (``wake_open``, ``inlet_meniscus_at_rim``, ...) as Python
-    booleans (None for empty cells), so that a written "False" does not read as true."""
-    try:
-        with open(path, newline="") as fh:
-            return history_columns(list(csv.DictReader(fh)))
-    except FileNotFoundError:
-        return None
-
-
-def history_columns(rows: list[dict[str, str]]) -> dict[str, np.ndarray] | None:
-    """The rows of a history.csv (``csv.DictReader``'s) as :func:`read_history`'s columns;
-    None for no rows."""
-    if not rows:
-        return None
-    out: dict[str, np.ndarray] = {}
-    for key in rows[0]:
-        values = [r.get(key) or "" for r in rows]
-        if key == "state":
-            out[key] = np.array(values, dtype=object)
-            continue
-        if set(values) & _FLAGS.keys() and set(values) <= _FLAGS.keys() | {"", "None"}:
-            out[key] = np.array([_FLAGS.get(v) for v in values], dtype=object)
-            continue
-        try:
-            out[key] = np.array([float(v) if v not in ("", "None") else math.nan for v in values])
-        except ValueError:
-            out[key] = np.array(values, dtype=object)
-    return out
 
 
 def tail_lines(path: Path, n: int = LOG_TAIL_LINES, chunk: int = 65536) -> list[str]:
@@ -193,8 +175,10 @@ def find_log(case: Path, geom: CaseGeometry | None) -> Path | None:
     return logs[-1] if logs else None
 
 
-def _status(metrics: dict | None, log: Path | None) -> tuple[str, str]:
-    """(status, a sentence about it)."""
+def _status(metrics: dict | None, log: Path | None, case: Path | None = None
+            ) -> tuple[str, str]:
+    """(status, a sentence about it). A metrics.json that says running while no process
+    holds the case's run lock was left by a run that was killed: interrupted."""
     age = time.time() - log.stat().st_mtime if log and log.exists() else None
     if metrics is None:
         if log is None:
@@ -210,6 +194,10 @@ def _status(metrics: dict | None, log: Path | None) -> tuple[str, str]:
         steady = "steady state reached" if metrics.get("steady") else \
             f"not steady (ended at {reason})"
         return status, f"The run finished: {steady}."
+    if status == "running" and case is not None and not run_lock_held(case):
+        return "interrupted", ("The run was killed before it ended (monitor_killed: "
+                               "metrics.json says running, but no process holds its run "
+                               "lock); this report shows its last write.")
     if status == "running":
         live = (f"the solver log was written {age:.0f} s ago" if age is not None
                 else "no solver log yet")
@@ -234,9 +222,9 @@ def load_case(case: str | os.PathLike) -> CaseInfo:
     problems: list[str] = []
     geom = load_geometry_tolerant(case, problems)
     spec, spec_dict = _load_spec(case, problems)
-    metrics = _read_json(case / "metrics.json", problems)
+    metrics = _read_metrics(case, problems)
     log = find_log(case, geom)
-    status, detail = _status(metrics, log)
+    status, detail = _status(metrics, log, case)
     try:
         history = read_history(case / "history.csv")
     except (OSError, csv.Error) as exc:

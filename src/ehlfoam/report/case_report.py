@@ -105,8 +105,8 @@ def solver_table(info: CaseInfo, n_times: int) -> Table:
                  ["End time", f"{g.end_time * 1e3:.4g}", "ms"]]
     rows += [["Written times", str(n_times), ""],
              ["Time steps", units.fmt_number(m.get("time_steps")), ""],
-             ["Simulated time", units.display(m.get("simulated_time_s"), ("", "", 1e3)), "ms"],
-             ["Wall time", units.display(m.get("wall_s"), ("", "", 1.0)), "s"]]
+             *([units.METRICS[k].label, units.display(m.get(k), units.METRICS[k]),
+                units.METRICS[k].unit] for k in ("simulated_time_s", "wall_s"))]
     return Table("Solver and mesh", ["", "value", "unit"],
                  [[r[0], cell(r[1], num=True), r[2]] for r in rows])
 

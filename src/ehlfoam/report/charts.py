@@ -1,20 +1,23 @@
 """Charts (matplotlib): a case's history, and a batch's bubble length and flow states.
 
-History: the quantities the monitor's steady-state test tracks (runs/run_case.py
-``_steady``: oil volume, meniscus positions, flooded size, gas behind the contact / bubble
-length), against time, with the last transit window and the test's tolerance band drawn, so
-that a reader sees whether the run settled and by how much it missed.
+History: the quantities the monitor's steady-state test tracks
+(:func:`ehlfoam.run.steady.steady_test`: oil volume, meniscus positions, flooded size, gas
+behind the contact / bubble length), against time, with the last transit window and the
+test's tolerance band drawn, so that a reader sees whether the run settled and by how much
+it missed.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from ehlfoam.report import style
+from ehlfoam.report import style, units
 
 #: history.csv length columns and their legend labels (units a).
 LENGTHS = {
@@ -91,26 +94,28 @@ def draw_history(history: dict[str, np.ndarray], out: Path, *, title: str,
     shade = (t_ms[-1] - window * 1e3, t_ms[-1]) if st.window_s is not None else None
 
     ax = axes[0]
+    vol = units.METRICS["oil_volume_m3"]            # bubble_volume_m3 is shown alike
     v = history.get("oil_volume_m3")
     if v is not None:
-        ax.plot(t_ms, v * 1e12, color="tab:brown", lw=1.4, marker=".", ms=3, label="oil")
+        ax.plot(t_ms, v * vol.scale, color="tab:brown", lw=1.4, marker=".", ms=3, label="oil")
         if shade:
-            ax.fill_between(shade, v[-1] * 1e12 * (1 - tol), v[-1] * 1e12 * (1 + tol),
+            ax.fill_between(shade, v[-1] * vol.scale * (1 - tol), v[-1] * vol.scale * (1 + tol),
                             color="tab:green", alpha=0.2, lw=0, label=f"+-{tol:.0%} of last")
     bv = history.get("bubble_volume_m3")
     if bv is not None and np.isfinite(bv).any():
-        ax.plot(t_ms, bv * 1e12, color=style.BUBBLE_RGB, lw=1.2, label="bubble (gas)")
-    ax.set_ylabel("volume [nl]")
+        ax.plot(t_ms, bv * vol.scale, color=style.BUBBLE_RGB, lw=1.2, label="bubble (gas)")
+    ax.set_ylabel(f"volume [{vol.unit}]")
     _panel_title(ax, "oil volume (whole contact)")
     ax.legend(fontsize=7.5, loc="lower right")
 
     ax = axes[1]
+    flow = units.METRICS["oil_inflow_m3_s"]         # history.csv's oil_in_m3_s, oil_out_m3_s
     for key, label, colour in (("oil_in_m3_s", "in", "tab:blue"),
                                ("oil_out_m3_s", "out", "tab:orange")):
         col = history.get(key)
         if col is not None:
-            ax.plot(t_ms, col * 1e12, lw=1.2, color=colour, label=f"oil {label}")
-    ax.set_ylabel("flow [nl/s]")
+            ax.plot(t_ms, col * flow.scale, lw=1.2, color=colour, label=f"oil {label}")
+    ax.set_ylabel(f"flow [{flow.unit}]")
     _panel_title(ax, "oil through the open boundaries")
     ax.legend(fontsize=7.5, loc="lower right")
 
@@ -197,9 +202,9 @@ def fit_bubble_relation(xs: np.ndarray, ls: np.ndarray, temperature: float) -> F
 
 def draw_bubble_vs_speed(points: list[dict], out: Path, *, label: str,
                          dpi: int = style.DPI) -> tuple[Path, list[Fit]]:
-    """l/a against u [mm/s], one colour per temperature. Fitted: state I cases with a
-    bubble (l > 0), filled; not fitted: state II (open wake, hollow) and state I without a
-    bubble (l = 0, crosses). ``points``: dicts with speed [m/s], temperature [C], l_over_a,
+    """l/a against u (in its display unit), one colour per temperature. Fitted: state I cases
+    with a bubble (l > 0), filled; not fitted: state II (open wake, hollow) and state I
+    without a bubble (l = 0, crosses). ``points``: dicts with speed [m/s], temperature [C], l_over_a,
     x (the relation's X), state."""
     fig = style.new_figure(9.0, 4.6, dpi)
     ax = fig.add_axes((0.08, 0.12, 0.52, 0.78))
@@ -208,7 +213,7 @@ def draw_bubble_vs_speed(points: list[dict], out: Path, *, label: str,
     for k, temp in enumerate(temps):
         colour = fig_colour(k)
         pts = [p for p in points if p["temperature"] == temp]
-        u = np.array([p["speed"] for p in pts]) * 1e3
+        u = np.array([p["speed"] for p in pts]) * units.SPEC["contact.speed"].scale
         l_a = np.array([p["l_over_a"] for p in pts], float)
         xs = np.array([p["x"] for p in pts], float)
         state_i = np.array([p["state"] == "I" for p in pts])
@@ -227,7 +232,7 @@ def draw_bubble_vs_speed(points: list[dict], out: Path, *, label: str,
             slope = np.polyfit(u[fitted], xs[fitted], 1)   # X is proportional to u
             ax.plot(uu, fit.c1 * np.polyval(slope, uu) + fit.c2, "-", color=colour, lw=1.0,
                     label=f"{temp:g} C: C1 = {fit.c1:.3g}, C2 = {fit.c2:.3g}")
-    ax.set_xlabel("rolling speed u [mm/s]")
+    ax.set_xlabel(f"rolling speed {units.short_label('contact.speed')}")
     ax.set_ylabel("l / a")
     ax.grid(alpha=0.3)
     ax.set_title(f"{label} vs speed;\nfit l/a = C1 Re^-1/2 (Ca/2)^-5/4 We^-1/2 + C2",
@@ -248,10 +253,13 @@ def fig_colour(k: int):
 
 def draw_state_map(rows: list[dict], x_key: str, y_key: str, out: Path, *,
                    x_label: str, y_label: str, x_scale: float = 1.0, y_scale: float = 1.0,
-                   panel_key: str | None = None, dpi: int = style.DPI) -> Path:
+                   panel_key: str | None = None,
+                   panel_title: Callable[[Any], str] | None = None,
+                   dpi: int = style.DPI) -> Path:
     """State I / II (and failed, other) of each case over two parameters, one panel per
-    value of ``panel_key`` (e.g. temperature); an axis spanning a factor 4 or more is
-    logarithmic (base 2: supply layers double)."""
+    value of ``panel_key`` (e.g. temperature, titled ``panel_title(value)``); an axis
+    spanning a factor 4 or more is logarithmic (base 2: supply layers double). The values
+    are drawn times ``x_scale`` and ``y_scale`` (SI to the labels' display units)."""
     import matplotlib
     import matplotlib.ticker  # noqa: F401
 
@@ -300,7 +308,8 @@ def draw_state_map(rows: list[dict], x_key: str, y_key: str, out: Path, *,
             ax.set_ylabel(y_label)
         ax.grid(alpha=0.3)
         if panel_key:
-            ax.set_title(f"{panel_key} = {value}", fontsize=9.5)
+            ax.set_title(panel_title(value) if panel_title else f"{panel_key} = {value}",
+                         fontsize=9.5)
         if seen and k == n - 1:
             ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     style.save(fig, out)

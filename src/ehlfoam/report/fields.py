@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ehlfoam.case.writer import CaseGeometry
+from ehlfoam.case.geometry import CaseGeometry
 from ehlfoam.metrics import pattern as flow
 from ehlfoam.run.fields import Structure, column_raster, time_folders
 

@@ -60,7 +60,7 @@ def cut_at_axis(fields: Fields) -> Cut:
     u = np.asarray(sl.cell_data["U"], float) if "U" in sl.cell_data else \
         np.zeros((len(tri), 3))
     # the ball along the cut, from the case's own gap export: the cut's highest points need
-    # not lie on the ball where the node columns lean (generator/mesh.py, "normal")
+    # not lie on the ball where the node columns lean (ehlfoam.mesh.extrude, "normal")
     px = np.unique(pts[:, 0])
     ph = GapField.load(fields.folder.parent / "precalc")(px, np.full_like(px, y_c))
     return Cut(x=pts[:, 0], z=pts[:, 2], triangles=tri, alpha=np.clip(alpha, 0, 1),

@@ -20,7 +20,7 @@ from scipy import ndimage
 
 from ehlfoam.metrics import pattern as flow
 
-from ehlfoam.report import style
+from ehlfoam.report import style, units
 
 _FOUR = ndimage.generate_binary_structure(2, 1)
 _EIGHT = ndimage.generate_binary_structure(2, 2)
@@ -107,7 +107,8 @@ def caption_lines(pattern: dict, a: float, time_s: float, transit_s: float | Non
     l_a, l_label = bubble_length(pattern)
     enclosed = pattern.get("enclosed_bubbles")
     bubble = "no gas behind the contact" if l_a == 0 else f"{l_label} {_fmt(l_a)} a"
-    oil = f" | oil {oil_volume * 1e12:.3g} nl" if oil_volume else ""
+    vol = units.METRICS["oil_volume_m3"]
+    oil = f" | oil {oil_volume * vol.scale:.3g} {vol.unit}" if oil_volume else ""
     transits = f" = {time_s / transit_s:.2f} transits" if transit_s else ""
     mirrored = "half domain mirrored about y = 0, " if symmetric else ""
     return [f"State {state}: {what}.",
@@ -181,7 +182,8 @@ def draw_top_view(r: flow.Raster, pattern: dict, out: Path, *, title: str,
     ax.add_artist(AnchoredSizeBar(ax.transData, bar, f"{bar:g} mm", "lower left", pad=0.4,
                                   sep=3, frameon=True, size_vertical=0.008 * (y1 - y0),
                                   color="black", fontproperties={"size": 8}))
-    ax.annotate(f"rolling, u = {speed * 1e3:.3g} mm/s", xy=(0.30, 0.94),
+    u = units.SPEC["contact.speed"]
+    ax.annotate(f"rolling, {u.symbol} = {speed * u.scale:.3g} {u.unit}", xy=(0.30, 0.94),
                 xytext=(0.02, 0.94), xycoords="axes fraction", va="center", fontsize=9,
                 arrowprops=dict(arrowstyle="-|>", lw=1.6, color="black"),
                 bbox=dict(fc="white", ec="none", alpha=0.8, pad=1.5), zorder=8)

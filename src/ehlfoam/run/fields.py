@@ -16,7 +16,8 @@ import numpy as np
 from foamlib import FoamFieldFile
 from scipy.spatial import cKDTree
 
-from ehlfoam.case.writer import AIR_GAS_CONSTANT, META, CaseGeometry
+from ehlfoam.case.dictionaries import AIR_GAS_CONSTANT
+from ehlfoam.case.geometry import META, CaseGeometry
 
 from ehlfoam.metrics import pattern as metrics
 
@@ -164,8 +165,7 @@ class Sample:
 
 
 def pattern_geometry(geom: CaseGeometry) -> metrics.Geometry:
-    return metrics.Geometry(a=geom.a, island_radius=geom.island_radius, x_min=geom.x_min,
-                            x_max=geom.x_max, y_max=geom.y_max, symmetric=geom.symmetric)
+    return metrics.Geometry.of(geom.box, geom.a)
 
 
 def _read_alpha(path: Path, structure: Structure) -> tuple[np.ndarray, FoamFieldFile]:
@@ -193,8 +193,8 @@ def smeared_oil_fraction(alpha: np.ndarray, cell_volumes: np.ndarray) -> float |
     (:data:`SMEARED_ALPHA`): how diffuse the interface is. A thin-gap meniscus is one or two
     cells wide in the plane, so a sharp run keeps a small, level-dependent share; the
     interface-limited compression scheme (``physics.interface_schemes = "balanced"``)
-    raised it from 31 % to 44-48 % on the coarse nominal case (docs/cases.md). None without
-    oil."""
+    raised it from 31 % to 44-48 % on the nominal case (docs/validation.md#v-balanced-rolling).
+    None without oil."""
     a = np.clip(np.asarray(alpha, float), 0.0, 1.0)
     oil = a * np.asarray(cell_volumes, float)
     total = float(oil.sum())
@@ -289,7 +289,7 @@ def advancing_front_cells(folder: Path, structure: Structure, geom: CaseGeometry
     (:func:`metrics.advancing_front` of the mid-gap oil at ``folder``): the in-plane size of
     the column there (the square root of its area) over its wall cell's height. A contact line
     advancing onto dry walls holds a capillary suction only where that is within some 15
-    (``bench/contact_line_strip.py``). Empty without such an edge."""
+    (the contact-line strip, :mod:`ehlfoam.case.strip`). Empty without such an edge."""
     r = mid_gap_raster(read_alpha(folder / "alpha.oil", structure), structure, geom)
     points = metrics.advancing_front(r, track_half_width)
     if not len(points):

@@ -1,14 +1,13 @@
 """Bands of finer cells along a run's meniscus, for the next run's mesh (``ehlfoam band``).
 
-A meniscus in the thin gap holds its capillary suction only in in-plane cells of a few wall
-cells where dry walls run into it, and lays its films right only in cells of 0.05-0.1 a at the
-rear (docs/cases.md, "The region's sides are moving contact lines", "The films decide the
-width"). Hand-placed boxes (``mesh.refine``) covered it piece by piece; this module reads the
-meniscus itself off a written time, the ``alpha = 0.5`` lines of the mid-gap oil fraction, and
-turns each line into a :class:`~ehlfoam.spec.case.RefineBand` of a chosen size and half-width
-in the half domain y >= 0. A run continued from that write (``--start-from``) on a mesh with the
-bands then has its whole meniscus in the band's cells, as long as the meniscus stays within the
-band.
+A meniscus in the thin gap holds its capillary suction only in in-plane cells within about 15
+wall cells where dry walls run into it, and lays its films right only in cells of 0.05-0.1 a at
+the rear (docs/models/interface.md#the-contact-line-model-and-what-converges). Hand-placed
+boxes (``mesh.refine``) covered it piece by piece; this module reads the meniscus itself off a
+written time, the ``alpha = 0.5`` lines of the mid-gap oil fraction, and turns each line into a
+:class:`~ehlfoam.spec.mesh.RefineBand` of a chosen size and half-width in the half domain
+y >= 0. A run continued from that write (``--start-from``) on a mesh with the bands then has
+its whole meniscus in the band's cells, as long as the meniscus stays within the band.
 
     ehlfoam band CASE --size 0.06 --half-width 1.0 [--time last|start|T] [--spacing 0.25]
         [--min-length 1.0]
@@ -19,14 +18,12 @@ prints the bands as TOML inline tables, ready for ``--set 'mesh.refine=[...]'`` 
 
 from __future__ import annotations
 
-import argparse
-import sys
 from pathlib import Path
 
 import numpy as np
 
-from ehlfoam.spec.case import RefineBand, SideBox
-from ehlfoam.case.writer import load_geometry
+from ehlfoam.spec.mesh import RefineBand, SideBox
+from ehlfoam.case.geometry import load_geometry
 
 from ehlfoam.run import fields as case_fields
 from ehlfoam.metrics import pattern as metrics
@@ -97,7 +94,7 @@ def meniscus_bands(lines: list[np.ndarray], size: float, half_width: float,
 def side_bands(bands: list[RefineBand], sides: SideBox) -> list[RefineBand]:
     """A band of half the size and half the half-width (or the sizes ``sides`` gives) along
     each run of consecutive points of ``bands`` that lies in ``sides`` (the region's sides,
-    where the meniscus sets the width; :class:`~ehlfoam.spec.case.SideBox`). Runs of a
+    where the meniscus sets the width; :class:`~ehlfoam.spec.mesh.SideBox`). Runs of a
     single point are left out."""
     out = []
     for band in bands:
@@ -119,50 +116,3 @@ def bands_toml(bands: list[RefineBand]) -> str:
         return f"{{half_width={b.half_width:g},size={b.size:g},points=[{pts}]}}"
     return "[" + ",\n".join(one(b) for b in bands) + "]"
 
-
-def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("band", help="bands of finer cells along a run's meniscus (mesh.refine)",
-                       description=__doc__.split("\n\n")[0])
-    p.add_argument("case", type=Path)
-    p.add_argument("--size", type=float, required=True, help="cell size in the band [a]")
-    p.add_argument("--half-width", type=float, required=True,
-                   help="the band reaches this far either side of the meniscus [a]")
-    p.add_argument("--time", default="last",
-                   help="transits of the write to read, 'last', or 'start' (the initial field: "
-                        "a case started from a thin-film state has its meniscus there)")
-    p.add_argument("--spacing", type=float, default=None,
-                   help="distance between the band's points [a] (default half-width / 4)")
-    p.add_argument("--min-length", type=float, default=None,
-                   help="leave out meniscus lines shorter than this [a] (default half-width)")
-    p.set_defaults(func=cmd_band)
-
-
-def _check_args(args: argparse.Namespace) -> None:
-    """Bad numbers fail before the case is read, naming the option and its range."""
-    for name, value, hi in (("--size", args.size, 10.0), ("--half-width", args.half_width, 20.0),
-                            ("--spacing", args.spacing, 20.0)):
-        if value is not None and not 0.0 < value <= hi:
-            raise ValueError(f"{name} = {value:g} a is out of range (0 < {name} <= {hi:g} a)")
-    if args.min_length is not None and not 0.0 <= args.min_length <= 1e3:
-        raise ValueError(f"--min-length = {args.min_length:g} a is out of range "
-                         "(0 <= --min-length <= 1000 a)")
-
-
-def cmd_band(args: argparse.Namespace) -> int:
-    try:
-        _check_args(args)
-        time, lines = meniscus_lines(args.case, args.time)
-    except (ValueError, FileNotFoundError) as err:
-        print(f"ehlfoam band: {err}", file=sys.stderr)
-        return 2
-    bands = meniscus_bands(lines, args.size, args.half_width, args.spacing, args.min_length)
-    if not bands:
-        shortest = args.half_width if args.min_length is None else args.min_length
-        print(f"ehlfoam band: {args.case} has no meniscus line of {shortest:g} a or longer "
-              f"at t = {time:g} s",
-              file=sys.stderr)
-        return 1
-    print(bands_toml(bands))
-    print(f"# {len(bands)} band(s) along the meniscus of {args.case} at t = {time:g} s, "
-          f"{sum(len(b.points) for b in bands)} points", file=sys.stderr)
-    return 0

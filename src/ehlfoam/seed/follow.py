@@ -1,11 +1,10 @@
 """Cases whose mesh follows the meniscus of the state they start from (``mesh.follow``).
 
-The levels of :data:`~ehlfoam.spec.case.RESOLUTIONS` leave the meniscus in their base cells,
+The levels of :data:`~ehlfoam.spec.levels.RESOLUTIONS` leave the meniscus in their base cells,
 and the flooded width does not converge over them; with bands of cells along the whole
 meniscus, twice as fine on the region's sides, and one thin wall cell everywhere
-(:data:`~ehlfoam.spec.case.FOLLOW_LEVELS`, whose comment gives what they converge), the
-meniscus is resolved on every level (docs/cases.md, "Resolved levels"). A case of such a
-level is written in three steps:
+(:data:`~ehlfoam.spec.levels.FOLLOW_LEVELS`), the meniscus is resolved on every level
+(docs/models/interface.md#the-mesh). A case of such a level is written in three steps:
 
 1. a probe case on the level's base mesh, without bands, started from the source
    (``--start-from``: a run case, a case snapshot or a thin-film state);
@@ -26,7 +25,9 @@ from pathlib import Path
 from typing import Any
 
 from ehlfoam.spec.case import CaseSpec, make_case_spec
-from ehlfoam.case.writer import CaseExists, CaseGeometry, write_case
+from ehlfoam.case.geometry import CaseGeometry
+from ehlfoam.case.ownership import check_replaceable
+from ehlfoam.case.writer import write_case
 
 from ehlfoam.seed.band import meniscus_bands, meniscus_lines, side_bands
 from ehlfoam.seed.start import seed_case
@@ -81,13 +82,16 @@ def write_started_case(spec: CaseSpec, out: str | Path, source: str | Path | Non
     """Write ``spec``'s case in ``out`` and start it from ``source`` (None: the spec's own
     start); with ``mesh.follow`` its mesh follows the source's meniscus
     (:func:`following_spec`). Returns the case geometry and the seed's record (None without a
-    source). Raises ValueError for ``mesh.follow`` without a source (the case writer's)."""
-    out = Path(out)
+    source). Raises ValueError for ``mesh.follow`` without a source (the case writer's), and
+    :class:`~ehlfoam.case.ownership.CaseExists` for an ``out`` that may not be written (before
+    any work). The start is written into the case before it is renamed into place: a start
+    that fails leaves no case behind (and an earlier case it was to replace as it was)."""
+    out = Path(out).absolute()
+    check_replaceable(out, overwrite)
     if spec.mesh.follow is not None and source is not None:
-        if out.exists() and any(out.iterdir()) and not overwrite:
-            raise CaseExists(f"output folder {out} exists and is not empty (use --overwrite)")
         out.parent.mkdir(parents=True, exist_ok=True)
         spec = following_spec(spec, source, scratch=out.parent)
-    geom = write_case(spec, out, overwrite=overwrite)
-    seed = None if source is None else seed_case(out, source)
-    return geom, seed
+    seeded: list[dict[str, Any]] = []
+    prepare = None if source is None else (lambda tmp: seeded.append(seed_case(tmp, source)))
+    geom = write_case(spec, out, overwrite=overwrite, prepare=prepare)
+    return geom, (seeded[0] if seeded else None)

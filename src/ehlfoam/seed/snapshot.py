@@ -21,10 +21,8 @@ A snapshot of a 66,060-cell case (20 layers) takes 0.51 MB, 0.14 MB with alpha.o
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
-import sys
 from pathlib import Path
 from typing import Any, Iterable
 
@@ -32,11 +30,11 @@ import numpy as np
 from foamlib import FoamFieldFile
 
 from ehlfoam._io import atomic_write
-from ehlfoam.case.writer import META, load_geometry
+from ehlfoam.case.geometry import META, load_geometry
 
 from ehlfoam.run.fields import Structure, time_folders, write_near
 from ehlfoam.seed.mapping import LayeredMesh, carry_oil, interpolate
-from ehlfoam.seed.start import check_same_gap, write_seed
+from ehlfoam.seed.write import check_same_gap, write_seed
 
 #: The ``kind`` entry that tells a snapshot from a thin-film state (both are .npz).
 KIND = "ehlfoam-case-snapshot"
@@ -160,8 +158,8 @@ def map_snapshot(case: Path, s: Structure, snapshot: Path, names: Iterable[str]
                  ) -> tuple[dict[str, np.ndarray], dict[str, Any] | None, dict[str, Any]]:
     """The snapshot's fields among ``names`` interpolated onto ``case``'s mesh (its loaded
     :class:`Structure` ``s``), the oil at its source's volume: (fields, how the oil was
-    carried over (:func:`.field_mapping.carry_oil`; None without alpha.oil), the snapshot's
-    record). Raises :class:`.ramp.RampError` for a snapshot of another contact (its gaps
+    carried over (:func:`.mapping.carry_oil`; None without alpha.oil), the snapshot's
+    record). Raises :class:`.write.RampError` for a snapshot of another contact (its gaps
     differ from the case's)."""
     source, their_gap, fields, record = load_snapshot(snapshot)
     target = LayeredMesh.of(s)
@@ -183,7 +181,7 @@ def seed_from_snapshot(case: str | Path, snapshot: str | Path) -> dict[str, Any]
     layer by layer onto its mesh (:func:`map_snapshot`; the same mesh gets its own values
     back, to the snapshot's precision). Returns (and writes to ``case/ehlfoam/ramp.json``)
     {"previous", "previous_time_s", "method": "snapshot", "fields", "cells", "source", "oil"
-    (how the oil was carried over, :func:`.field_mapping.carry_oil`)}."""
+    (how the oil was carried over, :func:`.mapping.carry_oil`)}."""
     case, snapshot = Path(case).absolute(), Path(snapshot).absolute()
     own = [name for name in FIELDS if (case / "0.orig" / name).is_file()]
     out, oil, record = map_snapshot(case, Structure.load(case), snapshot, own)
@@ -214,7 +212,7 @@ def source_oil(record: dict[str, Any], case: Path, s: Structure
 
 def snapshot_history(snapshot: str | Path) -> tuple[dict[str, np.ndarray], float]:
     """(history columns, transit time [s]) of the run a snapshot was taken from, its
-    history.csv up to the snapshot's write as :func:`ehlfoam.report.case_data.read_history`
+    history.csv up to the snapshot's write as :func:`ehlfoam.run.history.read_history`
     reads it; raises :class:`SnapshotError` when it kept none."""
     _require_snapshot(snapshot)
     with np.load(snapshot, allow_pickle=False) as d:   # the record only, not the fields
@@ -230,7 +228,7 @@ def snapshot_history_of(record: dict[str, Any]) -> tuple[dict[str, np.ndarray], 
     import csv
     import io
 
-    from ehlfoam.report.case_data import history_columns
+    from ehlfoam.run.history import history_columns
 
     columns = (history_columns(list(csv.DictReader(io.StringIO(record["history"]))))
                if record.get("history") else None)
@@ -239,28 +237,3 @@ def snapshot_history_of(record: dict[str, Any]) -> tuple[dict[str, np.ndarray], 
     keep = columns["time_s"] <= record["time_s"] * (1.0 + 1e-9)
     return {k: v[keep] for k, v in columns.items()}, record["time_s"] / record["transits"]
 
-
-def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("snapshot", help="a run case's state in one small file (--start-from)",
-                       description=__doc__.split("\n\n")[0])
-    p.add_argument("case", type=Path)
-    p.add_argument("out", type=Path, help="the snapshot file to write (.npz)")
-    p.add_argument("--time", default="last",
-                   help="transits of the write to keep, or 'last' (default)")
-    p.add_argument("--fields", nargs="+", default=list(FIELDS), choices=FIELDS,
-                   help="fields to keep (alpha.oil always; U makes the file some 4 times "
-                        "larger and the first steps calmer)")
-    p.set_defaults(func=cmd_snapshot)
-
-
-def cmd_snapshot(args: argparse.Namespace) -> int:
-    try:
-        record = save_snapshot(args.case, args.out, args.time, tuple(args.fields))
-    except (SnapshotError, ValueError, OSError) as err:
-        print(f"ehlfoam snapshot: {err}", file=sys.stderr)
-        return 2
-    size = args.out.stat().st_size
-    print(f"snapshot {args.out}: {record['source']} at t = {record['time_s']:.6g} s "
-          f"({record['transits']:.4f} transits), {record['cells']} cells, "
-          f"{', '.join(record['fields'])}, {size / 1e6:.2f} MB")
-    return 0

@@ -1,8 +1,8 @@
 """Start a 3D case from a thin-film state: the flooded region the gap-averaged model balanced.
 
-The thin-film model (``ehlfoam.thinfilm.model``) brings the nominal region to its
+The thin-film model (:mod:`ehlfoam.thinfilm`) brings the nominal region to its
 balance in minutes on one core; a 3D case from the spec's puddle takes hours to get there on
-two. A state the model wrote (``bench/thin_film_region.py``, :mod:`ehlfoam.thinfilm.state`)
+two. A state the model wrote (``ehlfoam thin-film``, :mod:`ehlfoam.thinfilm.state`)
 gives the 3D case its oil instead: each column of cells is oil where the model's cell is
 flooded, and behind the menisci carries the model's films (its oil over the gap, c / h), half on
 each wall, as the spec's supply layers are laid. Columns off the model's grid keep the spec's
@@ -19,13 +19,13 @@ from typing import Any
 import numpy as np
 from foamlib import FoamFieldFile
 
-from ehlfoam.thinfilm.model import ThinFilmSolution
+from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state
-from ehlfoam.case.writer import wall_layers_fraction
+from ehlfoam.case.fields import wall_layers_fraction
 
 from ehlfoam.run.fields import Structure
 from ehlfoam.seed.mapping import relative_heights
-from ehlfoam.seed.start import check_same_gap, write_seed
+from ehlfoam.seed.write import check_same_gap, write_seed
 
 
 def _state_gap(sol: ThinFilmSolution, x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -1,9 +1,9 @@
 """A thin-film state on disc: the grid, oil and pressure of a ``ThinFilmSolution``.
 
-``bench/thin_film_region.py`` writes one per run (``.npz``); it starts the next run of the
-thin-film model (``--start``), and a 3D case can start from it (``ehlfoam case --start-from
-STATE.npz``, :mod:`ehlfoam.seed.thin_film`): the model reaches the flooded region's balance in
-minutes where a 3D run from a puddle takes hours.
+``ehlfoam thin-film`` (:mod:`ehlfoam.thinfilm.from_spec`) writes one per run (``.npz``); it
+starts the next run of the thin-film model (``--start``), and a 3D case can start from it
+(``ehlfoam case --start-from STATE.npz``, :mod:`ehlfoam.seed.thin_film`): the model reaches
+the flooded region's balance in minutes where a 3D run from a puddle takes hours.
 """
 
 from __future__ import annotations
@@ -12,17 +12,20 @@ from pathlib import Path
 
 import numpy as np
 
-from ehlfoam.thinfilm.model import Grid, ThinFilmSolution
+from ehlfoam._io import atomic_write
+from ehlfoam.thinfilm.problem import Grid
+from ehlfoam.thinfilm.solution import ThinFilmSolution
 
 
 def save_state(sol: ThinFilmSolution, path: str | Path) -> None:
     """Write the cell centres x, y [m], gaps h [m], ``flooded``, oil content c [m], pressure
-    p [Pa] and the menisci's fills of ``sol`` to ``path`` (.npz)."""
+    p [Pa] and the menisci's fills of ``sol`` to ``path`` (.npz), atomically."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(path, x=sol.grid.x, y=sol.grid.y, h=sol.grid.h, flooded=sol.flooded,
-                        content=sol.content, p=sol.p,
-                        fill=np.zeros(sol.flooded.shape) if sol.fill is None else sol.fill)
+    fill = np.zeros(sol.flooded.shape) if sol.fill is None else sol.fill
+    atomic_write(path, lambda fh: np.savez_compressed(
+        fh, x=sol.grid.x, y=sol.grid.y, h=sol.grid.h, flooded=sol.flooded,
+        content=sol.content, p=sol.p, fill=fill))
 
 
 def load_state(path: str | Path) -> ThinFilmSolution:

@@ -1,0 +1,290 @@
+"""The discrete thin-film model on one grid: the faces' conductances and Couette fluxes, the
+menisci's positions and pressures, the pressure solve on the flooded cells and the oil each
+step moves (:class:`Operators`; the model: :mod:`ehlfoam.thinfilm.march`)."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from scipy import ndimage
+from scipy.sparse import coo_matrix
+from scipy.sparse.linalg import spsolve
+
+from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
+
+
+class Operators:
+    """The face coefficients of one grid and the two halves of a step."""
+
+    def __init__(self, prob: ThinFilmProblem, grid: Grid):
+        d, u = grid.cell, prob.speed
+        k = 1.0 / (12.0 * prob.viscosity)
+        self.u, self.d = u, d
+        self.h = np.nan_to_num(grid.h)
+        self.island = grid.island
+        self.gx = np.nan_to_num(k * grid.hx**3)        # square faces: conductance [m3/(Pa s)]
+        self.gy = np.nan_to_num(k * grid.hy**3)
+        self.cx = np.nan_to_num(u * grid.hx * d)       # Couette flux of a full x face [m3/s]
+        self.g_side = 0.0 * grid.h_side if prob.closed_side else 2.0 * k * grid.h_side**3
+        self.g_out = 2.0 * self.gx[:, -1] if self.gx.shape[1] else np.zeros(0)
+        self.cx_out = np.nan_to_num(u * grid.h[:, -1] * d)
+        self.theta_s = np.radians(prob.contact_angle)
+        cos_t = np.cos(self.theta_s)
+        if prob.receding_meniscus == "bretherton":   # the pull where the walls leave at u
+            ca = prob.viscosity * u / prob.surface_tension
+            self.pull = (1.0 + 3.8 * ca ** (2.0 / 3.0)) / cos_t
+        elif prob.receding_meniscus == "static":
+            self.pull = 1.0
+        else:
+            self.pull = float(prob.receding_meniscus)
+        self.normal_sigma = 1.5 if prob.normal_length is None else prob.normal_length / d
+        self.film = prob.film
+        self.cap = prob.film * self.h                  # what a meniscus cell passes on [m]
+        on_track = np.clip((prob.track_half_width - (grid.y - d / 2)) / d, 0.0, 1.0)
+        self.q_supply = u * prob.supply * on_track * d  # into column 0 [m3/s]
+        self.young_laplace = 2.0 * prob.surface_tension * cos_t   # pcap = -it / h [N/m]
+        self.theta_a = None if prob.advancing_angle is None else np.radians(prob.advancing_angle)
+        self.dry = 1.0 - on_track[:, None]             # walls coming in dry: off the track
+        self.sub_cell = prob.meniscus_position == "sub-cell"
+        # the oil an open cell holds as the walls' layers, not as meniscus: the supply's
+        # layers ahead of the contact, the films elsewhere [m]
+        ahead = (grid.x < 0)[None, :] & np.ones_like(self.island)
+        self.layers = np.where(ahead, np.maximum(prob.supply * on_track[:, None], self.cap),
+                               self.cap)
+
+    def pull_factor(self, flooded: np.ndarray) -> np.ndarray | float:
+        """The dynamic menisci's pressure on every cell, a factor on the static one. The
+        receding pull, 1 + (pull - 1) n^(2/3) where the walls leave the meniscus at u n (n:
+        the x part of its outward normal, from the flooded cells smoothed over
+        ``normal_length``; Ca n is the capillary number of the films it lays); the advancing
+        angle, cos(theta) / cos(theta_s) with theta^3 = theta_s^3 + m (theta_a^3 - theta_s^3)
+        where the walls come in dry (off the track) and run into the meniscus at u m. So a
+        meniscus at an angle to u is not left to the staircase of the cells; 1 with static
+        menisci."""
+        if self.pull == 1.0 and self.theta_a is None:
+            return 1.0
+        phi = ndimage.gaussian_filter(flooded.astype(float), self.normal_sigma,
+                                      mode="nearest")
+        gy, gx = np.gradient(phi)
+        nx = -gx / np.maximum(np.hypot(gx, gy), 1e-12)
+        factor = 1.0 + (self.pull - 1.0) * np.clip(nx, 0.0, 1.0) ** (2.0 / 3.0)
+        if self.theta_a is not None:
+            m = np.clip(-nx, 0.0, 1.0)
+            theta = np.cbrt(self.theta_s**3 + m * (self.theta_a**3 - self.theta_s**3))
+            factor = factor + self.dry * (np.cos(theta) / np.cos(self.theta_s) - 1.0)
+        return factor
+
+    def fill(self, c: np.ndarray) -> np.ndarray:
+        """How far into each cell a meniscus beside it reaches: the cell's bulk oil (beyond
+        the walls' layers) over its room for it, 0-1."""
+        room = self.h - self.layers
+        return np.clip((c - self.layers) / np.where(room > 0, room, 1.0), 0.0, 1.0)
+
+    def menisci(self, flooded: np.ndarray, c: np.ndarray) -> "_Faces":
+        """Each face between a flooded cell and an open one: the flooded cell's conductance
+        to the meniscus and the meniscus's pressure, for x faces and y faces. The meniscus
+        sits theta cells from the flooded cell's centre, at the gap there (linear between
+        the two centres), conductance g / theta: sub-cell, theta = 1/2 + the open cell's
+        fill; cell, theta = 1 (the open cell's centre). Its pressure: Young-Laplace's,
+        times the dynamic menisci's factor (``pull_factor``)."""
+        factor = np.broadcast_to(self.pull_factor(flooded), flooded.shape)
+        theta = 0.5 + self.fill(c) if self.sub_cell else np.ones_like(c)
+        per_axis = {}
+        for axis, g in ((1, self.gx), (0, self.gy)):
+            lo = [slice(None), slice(None)]
+            hi = [slice(None), slice(None)]
+            lo[axis], hi[axis] = slice(None, -1), slice(1, None)
+            lo, hi = tuple(lo), tuple(hi)
+            hi_open = flooded[lo] & ~flooded[hi]        # else the lo side is the open one
+            th = np.where(hi_open, theta[hi], theta[lo])
+            h_f = np.where(hi_open, self.h[lo], self.h[hi])
+            h_o = np.where(hi_open, self.h[hi], self.h[lo])
+            h_m = h_f + th * (h_o - h_f)
+            safe = np.where(h_m > 0, h_m, 1.0)          # faces on the island carry nothing
+            suction = np.where(hi_open, factor[hi], factor[lo]) * self.young_laplace / safe
+            per_axis[axis] = (g / th, np.where(h_m > 0, -suction, 0.0), h_m)
+        (gx, px, hx), (gy, py, _) = per_axis[1], per_axis[0]
+        return _Faces(gx=gx, gy=gy, px=px, py=py, hx=hx)
+
+    def pressure(self, flooded: np.ndarray, c: np.ndarray, dt: float,
+                 faces: "_Faces") -> np.ndarray:
+        """p on the flooded cells, the menisci at ``faces``' pressures: each flooded cell's
+        outflow is what it holds beyond its gap / dt."""
+        ny, nx = flooded.shape
+        n = int(flooded.sum())
+        p = np.full((ny, nx), np.nan)
+        if n == 0:
+            return p
+        idx = -np.ones((ny, nx), dtype=np.int64)
+        idx[flooded] = np.arange(n)
+        rows, cols, vals = [], [], []
+        rhs = ((c - self.h) * self.d * self.d / dt)[flooded]
+        carried = self.u * c * self.d                  # what an open cell's walls carry on
+        zeros_y = np.zeros_like(self.gy)
+        for lo, hi, g, gm, full, open_lo, pm in (
+                (idx[:, :-1], idx[:, 1:], self.gx, faces.gx, self.cx, carried[:, :-1],
+                 faces.px),
+                (idx[:-1], idx[1:], self.gy, faces.gy, zeros_y, zeros_y, faces.py)):
+            lo, hi, g, gm = lo.ravel(), hi.ravel(), g.ravel(), gm.ravel()
+            full, open_lo, pm = full.ravel(), open_lo.ravel(), pm.ravel()
+            both = (lo >= 0) & (hi >= 0) & (g > 0)
+            a, b, gg = lo[both], hi[both], g[both]
+            rows += [a, b, a, b]
+            cols += [a, b, b, a]
+            vals += [gg, gg, -gg, -gg]
+            np.add.at(rhs, a, -full[both])
+            np.add.at(rhs, b, full[both])
+            sel = (lo >= 0) & (hi < 0) & (g > 0)       # flooded lo, meniscus in hi
+            rows.append(lo[sel]), cols.append(lo[sel]), vals.append(gm[sel])
+            np.add.at(rhs, lo[sel], -full[sel] + gm[sel] * pm[sel])
+            sel = (lo < 0) & (hi >= 0) & (g > 0)       # meniscus in lo, flooded hi
+            rows.append(hi[sel]), cols.append(hi[sel]), vals.append(gm[sel])
+            np.add.at(rhs, hi[sel], open_lo[sel] + gm[sel] * pm[sel])
+        first, side, last = idx[:, 0], idx[-1], idx[:, -1]
+        np.add.at(rhs, first[first >= 0], self.q_supply[first >= 0])
+        rows.append(side[side >= 0]), cols.append(side[side >= 0])
+        vals.append(self.g_side[side >= 0])
+        rows.append(last[last >= 0]), cols.append(last[last >= 0])
+        vals.append(self.g_out[last >= 0])
+        np.add.at(rhs, last[last >= 0], -self.cx_out[last >= 0])
+        A = coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                       shape=(n, n)).tocsr()
+        p[flooded] = spsolve(A, rhs, permc_spec="MMD_AT_PLUS_A")
+        return p
+
+    def step(self, flooded: np.ndarray, c: np.ndarray, dt: float):
+        """One step: (p, change of the oil [m], flux leaving the domain [m3/s], the flooded
+        cells opened). An open cell gives no more than it holds: the flooded cells drawing
+        on it get less and run short of a full gap (air comes in: they open next step). A
+        flooded cell that would run dry within the step opens now, and p is solved again."""
+        opened = np.zeros_like(flooded)
+        for _ in range(1000):
+            faces = self.menisci(flooded, c)
+            p = self.pressure(flooded, c, dt, faces)
+            dc, q_out = self.move(flooded, p, c, dt, faces)
+            dry = flooded & (c + dc < 0.0)
+            if not dry.any():
+                return p, dc, q_out, opened
+            opened |= dry
+            flooded = flooded & ~dry
+        raise RuntimeError("the flooded set did not settle within a step")
+
+    def move(self, flooded: np.ndarray, p: np.ndarray, c: np.ndarray, dt: float,
+             faces: "_Faces"):
+        """The change of the oil in every cell over dt [m] and the flux leaving the domain
+        [m3/s], the menisci at ``faces``. An open cell gives no more than it holds: what
+        the flooded region draws from it is cut back first (the flooded cell runs short of a
+        full gap), the films and layers it passes on only when that is not enough."""
+        u, d = self.u, self.d
+        fl, fr = flooded[:, :-1], flooded[:, 1:]
+        touch = touches(flooded) & ~self.island
+        # x faces lo -> hi: Poiseuille where a side is flooded, plus what the walls carry:
+        # a full gap out of a flooded cell, the films a receding meniscus lays out of the
+        # cell behind one, at most those films out of a cell beside one, else the layers
+        lays = fl[:, :-1] & ~flooded[:, 1:-1] & ~flooded[:, 2:]
+        carry = np.where(touch[:, :-1] & ~fr, np.minimum(c[:, :-1], self.cap[:, :-1]),
+                         c[:, :-1])
+        carry[:, 1:] = np.where(lays, self.film * faces.hx[:, :-1], carry[:, 1:])
+        qx = _face_flux(fl, fr, p[:, :-1], p[:, 1:], self.gx, faces.gx, faces.px)
+        qx += np.where(fl, self.cx, u * carry * d * (self.gx > 0))
+        qy = _face_flux(flooded[:-1], flooded[1:], p[:-1], p[1:], self.gy, faces.gy, faces.py)
+        q_side = np.where(flooded[-1], self.g_side * p[-1], 0.0)
+        q_last = np.where(flooded[:, -1], self.cx_out + self.g_out * p[:, -1],
+                          u * c[:, -1] * d)
+        held = c * d * d / dt                          # [m3/s] over the step
+        opn = ~flooded & ~self.island
+        # faces on which an open cell gives to a flooded one (lo -> hi positive, hi -> lo
+        # negative)
+        draw_x = (~fl & fr & (qx > 0)) | (fl & ~fr & (qx < 0))
+        draw_y = ((~flooded[:-1] & flooded[1:] & (qy > 0))
+                  | (flooded[:-1] & ~flooded[1:] & (qy < 0)))
+        layer = np.zeros_like(flooded)                 # the cells behind a receding meniscus
+        layer[:, 1:-1] = lays
+        for only_draws in (True, False):
+            if not only_draws:                         # films are laid from the region's oil
+                net = _net(qx, qy, q_last, q_side, self.q_supply)
+                deficit = np.where(layer & opn, np.clip(-(held + net), 0.0, None), 0.0)
+                qx += deficit[:, 1:]
+            for _ in range(100):
+                net = _net(qx, qy, q_last, q_side, self.q_supply)
+                short = opn & (held + net < -1e-12 * self.h * d * d / dt)
+                if not short.any():
+                    break
+                mx = draw_x if only_draws else np.ones_like(draw_x)
+                my = draw_y if only_draws else np.ones_like(draw_y)
+                give = _given(qx * mx, qy * my, 0 * q_last if only_draws else q_last,
+                              0 * q_side if only_draws else q_side)
+                short &= give > 0
+                if not short.any():
+                    break
+                room = (held + net + give) / np.where(short, give, 1.0)
+                scale = np.where(short, np.clip(room, 0.0, 1.0 - 1e-12), 1.0)
+                sx = np.where(qx > 0, scale[:, :-1], scale[:, 1:])
+                sy = np.where(qy > 0, scale[:-1], scale[1:])
+                qx = np.where(mx, qx * sx, qx)
+                qy = np.where(my, qy * sy, qy)
+                if not only_draws:
+                    q_last = q_last * scale[:, -1]
+                    q_side = q_side * scale[-1]
+        net = _net(qx, qy, q_last, q_side, self.q_supply)
+        return net * dt / (d * d), float(q_last.sum() + q_side.sum())
+
+
+class _Faces(NamedTuple):
+    """Per face, lo -> hi: the conductance to a meniscus, its pressure [Pa] and (x faces) the
+    gap there (used where one side is flooded and the other open), x faces (ny, nx - 1) and
+    y faces (ny - 1, nx)."""
+
+    gx: np.ndarray
+    gy: np.ndarray
+    px: np.ndarray
+    py: np.ndarray
+    hx: np.ndarray    # the gap at the meniscus on x faces [m]: a receding one lays f of it
+
+
+def _face_flux(f_lo, f_hi, p_lo, p_hi, g, g_m, p_m):
+    """Poiseuille flux lo -> hi [m3/s]: between two flooded cells, or from a flooded cell to
+    the meniscus in its open neighbour (conductance g_m, pressure p_m); none between open
+    cells."""
+    return np.where(f_lo & f_hi, g * (p_lo - p_hi),
+                    np.where(f_lo & ~f_hi, g_m * (p_lo - p_m),
+                             np.where(~f_lo & f_hi, g_m * (p_m - p_hi), 0.0)))
+
+
+def _net(qx, qy, q_last, q_side, q_supply):
+    """Net inflow of every cell [m3/s] from the face fluxes (lo -> hi), the supply into the
+    first column and the outflow through the last one and the side."""
+    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
+    net = np.zeros((ny, nx))
+    net[:, :-1] -= qx
+    net[:, 1:] += qx
+    net[:-1] -= qy
+    net[1:] += qy
+    net[:, 0] += q_supply
+    net[:, -1] -= q_last
+    net[-1] -= q_side
+    return net
+
+
+def _given(qx, qy, q_last, q_side):
+    """What every cell gives up [m3/s]: its outgoing face fluxes."""
+    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
+    out = np.zeros((ny, nx))
+    out[:, :-1] += np.clip(qx, 0, None)
+    out[:, 1:] += np.clip(-qx, 0, None)
+    out[:-1] += np.clip(qy, 0, None)
+    out[1:] += np.clip(-qy, 0, None)
+    out[:, -1] += np.clip(q_last, 0, None)
+    out[-1] += np.clip(q_side, 0, None)
+    return out
+
+
+def touches(flooded: np.ndarray) -> np.ndarray:
+    """Cells with a flooded 4-neighbour."""
+    t = np.zeros_like(flooded)
+    t[1:] |= flooded[:-1]
+    t[:-1] |= flooded[1:]
+    t[:, 1:] |= flooded[:, :-1]
+    t[:, :-1] |= flooded[:, 1:]
+    return t & ~flooded

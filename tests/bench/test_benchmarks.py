@@ -1,0 +1,124 @@
+"""The curated benchmarks (bench/*.py), each run as a user runs it, in its --quick size, in a
+subprocess: it exits 0, prints its table, writes its record only to --out, nothing into the
+tree, and the numbers it measured are the ones its model gives."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def run_bench(name: str, tmp_path: Path, *args: str) -> tuple[str, dict]:
+    """Run ``bench/NAME.py --quick --out TMP/NAME.json ARGS`` from the repository root: its
+    stdout and its record. Asserts it wrote nothing but the record (into tmp_path) and
+    nothing into bench/."""
+    def listing() -> list[str]:
+        return sorted(p.name for p in (ROOT / "bench").iterdir() if p.name != "__pycache__")
+
+    before = listing()
+    out = tmp_path / f"{name}.json"
+    proc = subprocess.run([sys.executable, f"bench/{name}.py", "--quick", "--out", str(out),
+                           *args], cwd=ROOT, capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert listing() == before
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+    assert f"wrote {out}" in proc.stdout
+    return proc.stdout, json.loads(out.read_text())
+
+
+def table_rows(stdout: str, heading: str) -> list[list[str]]:
+    """The words of each row of the printed table whose heading line holds ``heading``: the
+    lines after it as long as it (the table pads every row to the heading's width)."""
+    lines = stdout.splitlines()
+    start = next(i for i, line in enumerate(lines) if heading in line)
+    rows = []
+    for line in lines[start + 1:]:
+        if len(line) != len(lines[start]):
+            break
+        rows.append(line.split())
+    return rows
+
+
+@pytest.mark.slow
+def test_precalc_cost_times_two_grids_that_agree(tmp_path):
+    stdout, rec = run_bench("precalc_cost", tmp_path)
+    assert [r[0] for r in table_rows(stdout, "N  wall [s]")] == ["129", "257"]
+    coarse, fine = rec["rows"]
+    assert coarse["converged"] and fine["converged"]
+    assert 0 < fine["hmin_nm"] < fine["hc_nm"]
+    assert abs(fine["hc_nm"] - coarse["hc_nm"]) < 0.1 * fine["hc_nm"]
+    assert fine["cost_ratio"] == pytest.approx(fine["wall_s"] / coarse["wall_s"])
+    assert fine["cycles"] > 0 and fine["peak_GiB"] > 0
+
+
+@pytest.mark.slow
+def test_precalc_validation_meets_hertz_and_nvm(tmp_path):
+    stdout, rec = run_bench("precalc_validation", tmp_path)
+    assert "1. dry limit vs Hertz" in stdout and "2. NVM" in stdout
+    (dry,) = rec["dry"]
+    assert dry["p_max_over_pH"] == pytest.approx(1.0, abs=1e-3)
+    assert dry["max_err_r_lt_095"] < 2e-3
+    assert [(r["M"], r["L"]) for r in rec["nvm"]] == [(20, 5), (20, 10), (100, 5), (100, 10)]
+    for r in rec["nvm"]:
+        assert r["converged"] and 0.9 < r["hc_over_nvm"] < 1.05, r
+    assert len(table_rows(stdout, "M   L  grid")) == 4
+
+
+@pytest.mark.openfoam
+def test_case_cost_tabulates_two_levels(tmp_path):
+    stdout, rec = run_bench("case_cost", tmp_path)
+    coarse, medium = rec["rows"]
+    assert [r[0] for r in table_rows(stdout, "level  from")] == ["coarse", "medium"]
+    assert medium["cells"] > 1.5 * coarse["cells"]
+    assert medium["cells_ratio"] == pytest.approx(medium["cells"] / coarse["cells"])
+    for r in rec["rows"]:
+        assert r["end_reason"] == "end_time" and r["time_steps"] > 0, r
+        assert r["state"] in ("I", "II") and r["flooded_width_over_a"] > 0
+        assert r["oil_mass_balance_error"] < 0.05
+        assert r["solver_cpu_s"] > 0 and r["wall_s"] > 0
+
+
+@pytest.mark.openfoam
+@pytest.mark.slow
+def test_single_phase_check_meets_reynolds(tmp_path):
+    stdout, rec = run_bench("single_phase_check", tmp_path)
+    (row,) = rec["rows"]
+    assert row["status"] == "finished"
+    assert row["p_ref_max_Pa"] > 0 and row["p_cfd_max_Pa"] > 0
+    assert row["max_error_over_pmax"] < 0.15 and row["rms_error_over_pmax"] < 0.05
+    assert table_rows(stdout, "level  cells")[0][0] == "coarse"
+
+
+@pytest.mark.openfoam
+@pytest.mark.slow
+def test_batch_cost_runs_the_same_batch_twice_alike_and_reports_it(tmp_path):
+    stdout, rec = run_bench("batch_cost", tmp_path)
+    serial, local = rec["batches"]
+    assert serial["cases"] == local["cases"] == serial["finished"] == local["finished"] == 2
+    assert serial["cases_per_hour"] == pytest.approx(3600 * 2 / serial["wall_s"])
+    same = rec["compared"]["local vs one at a time"]
+    assert same["same_cases_states_steps"] and same["oil_volume_max_rel_diff"] < 1e-9
+    case, cold, warm = rec["reports"]
+    assert case["wall_s"] > 0 and warm["wall_s"] < cold["wall_s"]
+    assert "local vs one at a time: same cases, states and steps: True" in stdout
+
+
+@pytest.mark.openfoam
+def test_strips_lay_films_near_landau_levich_and_hold_a_contact_line(tmp_path):
+    stdout, rec = run_bench("strips", tmp_path)
+    (films,) = rec["films"]
+    assert films["status"] == "ok" and films["steps"] > 0
+    assert 0.5 < films["over_landau_levich"] < 3.0          # coarse cells: thicker films
+    assert abs(films["x_rear_last_over_a"] - films["x_landau_levich_over_a"]) < 1.0
+    (line,) = rec["contact-line"]
+    assert line["status"] == "ok"
+    assert 4.0 < line["meniscus_over_a"] < 6.3                # dragged towards the reservoir
+    assert line["static_angle_deg"] <= line["apparent_angle_deg"] < 90.0
+    assert "films behind a receding meniscus" in stdout
+    assert "advancing contact line on dry walls" in stdout

@@ -1,0 +1,54 @@
+"""A batch report's rows: results.csv and plan.json in the case spec's names (SI), an older
+batch folder's columns read as the current ones, and one display table for the inputs."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+
+from ehlfoam.batch.plan import PARAM_KEYS
+from ehlfoam.report import units
+from ehlfoam.report.batch_rows import read_results
+
+
+def _write(folder, columns, rows, plan):
+    folder.mkdir()
+    with open(folder / "results.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=columns)
+        w.writeheader()
+        w.writerows(rows)
+    (folder / "plan.json").write_text(json.dumps(plan))
+
+
+def test_current_and_older_batch_folders_read_alike(tmp_path):
+    now = {"case_id": "a", "contact.speed": "0.008", "contact.temperature": "40.0",
+           "contact.load": "20.0", "supply.mode": "layers", "supply.disc_layer": "1.5e-06",
+           "supply.ball_layer": "1.5e-06", "mesh.resolution": "coarse", "status": "finished",
+           "state": "I", "oil_volume_m3": "7e-11"}
+    old = {"case_id": "a", "speed_mm_s": "8.0", "temperature_C": "40.0", "load_N": "20.0",
+           "supply": "layers", "disc_layer_um": "1.5", "ball_layer_um": "1.5",
+           "resolution": "coarse", "status": "finished", "state": "I", "oil_volume_m3": "7e-11"}
+    _write(tmp_path / "now", list(now), [now],
+           [{"id": "a", "params": {}}, {"id": "b", "params": {"contact.speed": 0.012}}])
+    _write(tmp_path / "old", list(old), [old],
+           [{"id": "a", "params": {}}, {"id": "b", "params": {"speed_mm_s": 12.0}}])
+    a_now, b_now = read_results(tmp_path / "now")
+    a_old, b_old = read_results(tmp_path / "old")
+    for key in PARAM_KEYS:
+        expected = a_now[key]
+        assert a_old[key] == (pytest.approx(expected) if isinstance(expected, float)
+                              else expected), key
+    assert a_now["contact.speed"] == 0.008 and a_now["supply.mode"] == "layers"
+    assert b_now["status"] == b_old["status"] == "pending"
+    assert b_old["contact.speed"] == pytest.approx(b_now["contact.speed"]) == 0.012
+
+
+def test_every_parameter_has_its_display_in_the_one_table():
+    for key in PARAM_KEYS:
+        assert key in units.SPEC, key
+    assert units.short_label("contact.speed") == "u [mm/s]"
+    assert units.scaled("contact.speed", 0.008) == pytest.approx(8.0)
+    assert units.short_label("supply.disc_layer") == "disc layer [um]"
+    assert units.short_label("oil_volume_m3") == "Oil volume (whole contact) [nl]"
