@@ -23,7 +23,7 @@ from typing import Any
 def _child(spec_kwargs: dict, queue, workers: int | None = None) -> None:
     import os
 
-    from ehlfoam.contact.multigrid import numba_threads, solve_threads
+    from ehlfoam.contact.threads import numba_threads, solve_threads
     from ehlfoam.contact.solver import solve
     from ehlfoam.contact.spec import make_spec
 

@@ -71,7 +71,7 @@ NEIGHBOURS = (dict(speed=0.0125), dict(speed=0.02), dict(temperature=35.0),
 def reuse(case: dict) -> dict:
     """The nominal point on its default grid started from each of :data:`NEIGHBOURS` against
     the full multigrid start, on one thread, in this process: CPU time, cycles, hc change."""
-    from ehlfoam.contact.multigrid import numba_threads
+    from ehlfoam.contact.threads import numba_threads
     from ehlfoam.contact.solver import Start, solve
     from ehlfoam.contact.spec import make_spec
 

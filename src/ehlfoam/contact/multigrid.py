@@ -21,22 +21,19 @@ from __future__ import annotations
 
 import math
 import time
-from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
-import numba
 import numpy as np
 from scipy.ndimage import minimum_filter
 
 from ehlfoam.contact.elastic import Deformation, hertz_pressure
 from ehlfoam.contact.lubricant import PressureLaws, coefficients, coefficients_parallel
 from ehlfoam.contact.reynolds import relax, relax_parallel, residual, residual_parallel
+from ehlfoam.contact.threads import PARALLEL_MIN_POINTS, numba_threads, solve_threads
 from ehlfoam.contact.transfer import (prolong_bilinear, prolong_cubic, restrict_full_weighting,
                                       restrict_pressure)
 
 LOAD_TARGET = 2.0 * math.pi / 3.0
-#: Grids with fewer points than this run on one thread (threads cost more than they save).
-PARALLEL_MIN_POINTS = 300_000
 
 
 @dataclass(frozen=True)
@@ -222,27 +219,6 @@ class Level:
             limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step, ln_eta)
             if prob.neumann_outlet:
                 self.P[:, -1] = self.P[:, -2]
-
-
-def solve_threads(workers: int | None = None) -> int:
-    """Threads a solve uses, the one setting for both scipy.fft and the numba kernels:
-    ``workers`` if given, else the calling thread's numba thread count, which a batch sets to
-    the cores it gives the job (``numba.set_num_threads``), the environment sets by
-    ``NUMBA_NUM_THREADS``, and which is otherwise the cores this process may run on; never
-    more than numba's thread pool."""
-    n = numba.get_num_threads() if workers is None else int(workers)
-    return max(1, min(n, numba.config.NUMBA_NUM_THREADS))
-
-
-@contextmanager
-def numba_threads(n: int):
-    """Run the numba kernels of the block on ``n`` threads (the previous count restored)."""
-    prev = numba.get_num_threads()
-    numba.set_num_threads(n)
-    try:
-        yield
-    finally:
-        numba.set_num_threads(prev)
 
 
 def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
