@@ -123,8 +123,8 @@ def main(argv: list[str] | None = None) -> int:
     out: dict = {"case": case, "rows": rows}
     if len(args.grids) >= 3:
         out.update(richardson(rows))
-    print_table(rows, [("N", "N", "d"), ("threads", "threads", "d"),
-                       ("wall_s", "wall [s]", ".1f"), ("cpu_s", "CPU [s]", ".1f"),
+    print_table(rows, [("N", "N", "d"), ("wall_s", "wall [s]", ".1f"),
+                       ("threads", "threads", "d"), ("cpu_s", "CPU [s]", ".1f"),
                        ("cost_ratio", "x per doubling", ".2f"), ("cpu_ratio", "CPU x", ".2f"),
                        ("cycles", "cycles", "d"), ("peak_GiB", "peak [GiB]", ".2f"),
                        ("hc_nm", "hc [nm]", ".4f"), ("hmin_nm", "hmin [nm]", ".4f"),
