@@ -160,7 +160,9 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
             seed = seeded[0] if seeded else None
             build_s = time.monotonic() - t0
             stage = "run"
-            metrics = run_case(case)
+            # the batch fitted run.n_procs to its cores (--cores, --jobs, --oversubscribe)
+            # or to its Dask workers' CPU resources already
+            metrics = run_case(case, oversubscribe=True)
         except (CaseBusy, CaseBeingRun) as err:   # an `ehlfoam run` outside the batch
             return {"id": case_id, "kind": "case", "status": "busy", "reason": str(err)}
         except Exception as err:  # noqa: BLE001 - recorded, the batch goes on

@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -104,11 +105,10 @@ def run_task(batch_dir: str, kind: str, key: str, rerun_failed: bool, cpu: int) 
 
 # =========================================================================== executors
 def cpu_budget() -> int:
-    """CPU cores this process may use."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:
-        return os.cpu_count() or 1
+    """CPU cores this process may use (:func:`ehlfoam.case.bounds.usable_cores`)."""
+    from ehlfoam.case.bounds import usable_cores
+
+    return usable_cores()
 
 
 class LocalExecutor:
@@ -228,30 +228,79 @@ class DaskExecutor:
 
 SLURM_KEYS = {"cores": int, "memory": str, "walltime": str, "queue": str, "jobs": int,
               "account": str, "python": str}
+#: What each ``--slurm`` value may be: dask-jobqueue writes them into the sbatch script
+#: (``#SBATCH`` lines, the worker's command line) as they are, so a newline, ``;``, ``$``, a
+#: quote or a space would add directives or commands. Checked before the script is made.
+SLURM_PATTERNS = {
+    "memory": (r"[1-9][0-9]{0,5}(\.[0-9]{1,3})?(B|KB|MB|GB|TB|KiB|MiB|GiB|TiB)",
+               "a size like 4GB, 512MB or 1.5TB"),
+    "walltime": (r"([0-9]{1,3}-)?[0-9]{1,3}:[0-5][0-9]:[0-5][0-9]",
+                 "HH:MM:SS (or D-HH:MM:SS), e.g. 01:00:00"),
+    "queue": (r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}", "a partition name: letters, digits, _ . -"),
+    "account": (r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}", "an account name: letters, digits, _ . -"),
+    "python": (r"/?[A-Za-z0-9_.+-]+(/[A-Za-z0-9_.+-]+)*",
+               "a path to a Python interpreter: letters, digits, _ . + - and /"),
+}
+#: The most cores of one job and jobs of one batch (a typo guard)
+SLURM_MAX = {"cores": 4096, "jobs": 10000}
+SLURM_DEFAULTS: dict[str, Any] = {"cores": 1, "memory": "4GB", "walltime": "01:00:00",
+                                  "jobs": 1}
+
+
+def _slurm_value(key: str, value: Any) -> Any:
+    """One ``--slurm`` value, checked against its pattern; SpecError naming it."""
+    if key not in SLURM_KEYS:
+        raise SpecError(f"--slurm {key}: unknown key (valid: {', '.join(SLURM_KEYS)})")
+    if SLURM_KEYS[key] is int:
+        text = str(value).strip() if not isinstance(value, bool) else "?"
+        if not re.fullmatch(r"[0-9]{1,6}", text) or not 1 <= int(text) <= SLURM_MAX[key]:
+            raise SpecError(f"--slurm {key} = {value!r}: valid range 1 <= {key} <= "
+                            f"{SLURM_MAX[key]} (an integer)")
+        return int(text)
+    pattern, what = SLURM_PATTERNS[key]
+    if not isinstance(value, str) or not re.fullmatch(pattern, value):
+        raise SpecError(f"--slurm {key} = {value!r}: valid is {what} (no spaces, quotes, "
+                        f"newlines, ; or $: it goes into the sbatch script)")
+    return value
+
+
+def check_slurm(opts: Any) -> dict[str, Any]:
+    """Slurm options (``BatchOptions.slurm``, :func:`parse_slurm`) with every value checked
+    against its pattern (:data:`SLURM_PATTERNS`) and the defaults filled in; SpecError
+    naming the first bad one. No value reaches the sbatch script unchecked."""
+    if not isinstance(opts, dict):
+        raise SpecError(f"--slurm {opts!r}: give KEY=VALUE,... with KEY one of "
+                        f"{', '.join(SLURM_KEYS)}")
+    out = dict(SLURM_DEFAULTS)
+    for key, value in opts.items():
+        if value is None and key not in SLURM_DEFAULTS:
+            continue
+        out[key] = _slurm_value(str(key), value)
+    return out
 
 
 def parse_slurm(text: str) -> dict[str, Any]:
-    """``cores=32,memory=64GB,walltime=02:00:00,queue=normal,jobs=4`` -> dict."""
-    out: dict[str, Any] = {"cores": 1, "memory": "4GB", "walltime": "01:00:00", "jobs": 1}
+    """``cores=32,memory=64GB,walltime=02:00:00,queue=normal,jobs=4`` -> dict, every value
+    checked (:func:`check_slurm`)."""
+    given: dict[str, Any] = {}
     for item in filter(None, (t.strip() for t in text.split(","))):
         key, sep, value = item.partition("=")
         if not sep or key not in SLURM_KEYS:
             raise SpecError(f"--slurm {item!r}: give KEY=VALUE with KEY one of "
                             f"{', '.join(SLURM_KEYS)}")
-        try:
-            out[key] = SLURM_KEYS[key](value)
-        except ValueError:
-            raise SpecError(f"--slurm {key} = {value!r}: not an integer") from None
-        if key in ("cores", "jobs") and out[key] < 1:
-            raise SpecError(f"--slurm {key} = {out[key]}: valid range {key} >= 1")
-    return out
+        if key in given:
+            raise SpecError(f"--slurm {key} is given twice ({given[key]!r}, {value!r})")
+        given[key] = value
+    return check_slurm(given)
 
 
 def slurm_cluster(opts: dict[str, Any], scale: bool = True):
     """A dask-jobqueue SLURMCluster: one worker per job with ``cores`` threads and the
-    resource ``CPU = cores``; ``jobs`` jobs."""
+    resource ``CPU = cores``; ``jobs`` jobs. The options are checked first
+    (:func:`check_slurm`): SpecError before any script is written."""
     from dask_jobqueue import SLURMCluster
 
+    opts = check_slurm(opts)
     kw = {"cores": opts["cores"], "processes": 1, "memory": opts["memory"],
           "walltime": opts["walltime"],
           "worker_extra_args": ["--resources", f"CPU={opts['cores']}"]}

@@ -40,19 +40,22 @@ import signal
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from ehlfoam._io import atomic_write_json, atomic_write_text
 
 from ehlfoam.batch.case import oneline, precalc_cached
-from ehlfoam.batch.executors import DaskExecutor, LocalExecutor, cpu_budget, slurm_cluster
+from ehlfoam.batch.executors import (DaskExecutor, LocalExecutor, check_slurm, cpu_budget,
+                                     slurm_cluster)
 from ehlfoam.batch.folder import (BATCH_LOCK, CASES, LOCKS, PLAN, RESULTS, SPEC_COPY, STATUSES, batch_folder, case_status, file_lock)
 from ehlfoam.batch.progress import Progress
 from ehlfoam.batch.runner import BatchRunner
 from ehlfoam.batch.plan import PRECALC_CPU_S, PlannedCase, est_cpu_s, load_plan
-from ehlfoam.batch.spec import BatchSpec
+from ehlfoam.batch.spec import DEFAULT_MAX_CASES, BatchSpec
+from ehlfoam.case.bounds import LIMIT_KEYS, check_n_procs
+from ehlfoam.errors import SpecError
 
 
 class BatchError(RuntimeError):
@@ -98,7 +101,8 @@ def check_finished_specs(batch_dir: Path, plan: list[PlannedCase]) -> None:
             old = load_spec_of(case).model_dump()
         except Exception as err:  # noqa: BLE001
             raise BatchError(f"finished case {case} has an unreadable spec ({err})") from None
-        diff = [d for d in _spec_diff(old, pc.spec.model_dump()) if not d.startswith("name:")]
+        diff = [d for d in _spec_diff(old, pc.spec.model_dump())
+                if not d.startswith(("name:", *(f"{k}:" for k in LIMIT_KEYS)))]
         if diff:
             raise BatchError(
                 f"case {pc.id} finished with another case spec than the batch spec gives it "
@@ -119,6 +123,10 @@ class BatchOptions:
     client: Any = None                 # an existing distributed.Client (tests, timings)
     quiet: bool = False
     regime: bool = True                # the regime analysis (regime/regime.json)
+    #: the most cases the batch may ask for, counted before they are expanded
+    max_cases: int = DEFAULT_MAX_CASES
+    #: run cases (run.n_procs, --cores, --jobs) beyond the cores this process may use
+    oversubscribe: bool = False
     #: what reports the batch after its cases, called with the batch folder and the log
     #: (``ehlfoam batch`` passes :func:`ehlfoam.report.after_batch`); None: no report
     report: Callable[[Path, Callable[[str], None]], Any] | None = None
@@ -127,6 +135,30 @@ class BatchOptions:
         if self.report is not None and self.report is not False and not callable(self.report):
             raise TypeError(f"BatchOptions.report = {self.report!r}: give the function that "
                             f"reports a batch (ehlfoam.report.after_batch) or None")
+
+
+def check_cores(opts: BatchOptions, plan: list[PlannedCase]) -> None:
+    """The cores the batch asks for within what runs it, before anything is written: on this
+    machine ``run.n_procs``, ``--cores`` and ``--jobs`` x ``run.n_procs`` within the usable
+    cores unless ``oversubscribe``; on Slurm ``run.n_procs`` within a job's cores (a case
+    asking for more would wait for ever)."""
+    widest = max(plan, key=lambda pc: pc.n_procs)
+    need = widest.n_procs
+    if opts.client is not None or opts.scheduler:
+        return
+    if opts.slurm is not None:
+        if need > opts.slurm["cores"]:
+            raise SpecError(f"run.n_procs = {need} (case {widest.id}) is more than --slurm "
+                            f"cores = {opts.slurm['cores']}, the CPUs of each Slurm job's "
+                            f"worker (valid range 1 <= run.n_procs <= {opts.slurm['cores']})")
+        return
+    over = opts.oversubscribe
+    check_n_procs(need, oversubscribe=over, context=f" (case {widest.id})")
+    if opts.cores:
+        check_n_procs(opts.cores, oversubscribe=over, where="--cores")
+    if opts.jobs:
+        check_n_procs(opts.jobs, oversubscribe=over, where="--jobs", per=need,
+                      context=" cases at once")
 
 
 def _make_executor(opts: BatchOptions, plan: list[PlannedCase]):
@@ -181,7 +213,10 @@ def run_batch(spec_path: str | Path, opts: BatchOptions | None = None) -> BatchO
     written) or :class:`BatchError` (cannot start)."""
     opts = opts or BatchOptions()
     spec_path = Path(spec_path)
-    batch, plan = load_plan(spec_path)
+    if opts.slurm is not None:
+        opts = replace(opts, slurm=check_slurm(opts.slurm))
+    batch, plan = load_plan(spec_path, max_cases=opts.max_cases)
+    check_cores(opts, plan)
     batch_dir = batch_folder(spec_path, opts.out).absolute()
     check_finished_specs(batch_dir, plan)
     batch_dir.mkdir(parents=True, exist_ok=True)
@@ -236,12 +271,14 @@ def _raise_interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
-def dry_run(spec_path: str | Path, out: Path | None = None) -> str:
-    """The plan as a table (id, ramp, estimated CPU) without building anything."""
+def dry_run(spec_path: str | Path, out: Path | None = None,
+            max_cases: int = DEFAULT_MAX_CASES) -> str:
+    """The plan as a table (id, ramp, estimated CPU) without building anything; a batch of
+    more than ``max_cases`` cases is refused as by :func:`run_batch`."""
     from ehlfoam.gap.source import spec_key
 
     spec_path = Path(spec_path)
-    batch, plan = load_plan(spec_path)
+    batch, plan = load_plan(spec_path, max_cases=max_cases)
     batch_dir = batch_folder(spec_path, out)
     lines = [f"batch {batch.name}: {len(plan)} cases -> {batch_dir}"]
     contacts = {spec_key(pc.spec.contact) for pc in plan}

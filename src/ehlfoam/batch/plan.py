@@ -11,16 +11,20 @@ swept key); a ramp step's id adds ``rampA_up03_``. The id is a name, not a quant
 from __future__ import annotations
 
 import itertools
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ehlfoam.batch.spec import BatchSpec, load_batch_spec, overrides, rounded
+from ehlfoam.batch.spec import (DEFAULT_MAX_CASES, BatchSpec, check_max_cases, count_text,
+                                load_batch_spec, overrides, rounded)
+from ehlfoam.case.bounds import check_work
 from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import CaseSpec, make_case_spec
 
-__all__ = ["PARAM_KEYS", "PlannedCase", "case_id", "est_cpu_s", "expand", "load_plan"]
+__all__ = ["PARAM_KEYS", "PlannedCase", "case_count", "case_id", "est_cpu_s", "expand",
+           "load_plan"]
 
 #: The parameters every planned case carries (plan.json, results.csv), in order: the case
 #: spec's keys that name a case (SI; a layer is None unless the supply mode is "layers").
@@ -173,10 +177,39 @@ def _swept_keys(batch: BatchSpec) -> tuple[str, ...]:
     return tuple(keys)
 
 
-def expand(batch: BatchSpec) -> list[PlannedCase]:
+def case_count(batch: BatchSpec) -> int:
+    """How many cases ``batch`` asks for, from its value lists (not expanded): each sweep's
+    product, each ramp's steps (a case met twice counts twice)."""
+    return (sum(math.prod(len(v) for v in sw.root.values()) for sw in batch.sweep)
+            + sum(len(r.steps()) for r in batch.ramp))
+
+
+def _check_work(plan: dict[str, PlannedCase]) -> None:
+    """Each case within its mesh.max_cells and run.max_steps, estimated from its spec (cases
+    of the same mesh and time step estimated once)."""
+    seen: dict[str, str] = {}
+    for pc in plan.values():
+        key = pc.spec.model_dump_json(include={"contact", "mesh", "domain", "run", "physics",
+                                               "scene"})
+        if key in seen:
+            continue
+        try:
+            check_work(pc.spec)
+        except SpecError as err:
+            raise _invalid(f"case {pc.id}", err) from None
+        seen[key] = pc.id
+
+
+def expand(batch: BatchSpec, max_cases: int = DEFAULT_MAX_CASES) -> list[PlannedCase]:
     """The plan: sweep cases (union of the products, first occurrence kept), then the ramps'
     steps in run order. Every case spec is validated; raises :class:`SpecError` before
-    anything is built."""
+    anything is built: a batch of more than ``max_cases`` cases (counted first), a case spec
+    that is not valid, a case above its mesh.max_cells or run.max_steps."""
+    n = case_count(batch)
+    if n > check_max_cases(max_cases):
+        raise SpecError(f"invalid batch spec: the batch asks for {count_text(n)} cases, more "
+                        f"than max_cases = {max_cases:,}: sweep fewer values, or raise the cap "
+                        f"with --max-cases N (BatchOptions(max_cases=N))")
     try:
         make_case_spec(batch.base)
     except SpecError as err:
@@ -202,6 +235,7 @@ def expand(batch: BatchSpec) -> list[PlannedCase]:
             raise SpecError(f"invalid batch spec: case {pc.id} has mesh.follow but no state to "
                             f"start from, whose meniscus its mesh would follow: only a ramp's "
                             f"steps have one (its start_from, or the step before)")
+    _check_work(plan)
     return list(plan.values())
 
 
@@ -225,10 +259,12 @@ def _add(plan: dict[str, PlannedCase], batch: BatchSpec, values: dict[str, Any],
     return cid
 
 
-def load_plan(path: str | Path) -> tuple[BatchSpec, list[PlannedCase]]:
-    """Read, validate and expand a batch spec file."""
-    batch = load_batch_spec(path)
-    return batch, expand(batch)
+def load_plan(path: str | Path,
+              max_cases: int = DEFAULT_MAX_CASES) -> tuple[BatchSpec, list[PlannedCase]]:
+    """Read, validate and expand a batch spec file of at most ``max_cases`` cases (counted
+    before they are expanded)."""
+    batch = load_batch_spec(path, max_cases=max_cases)
+    return batch, expand(batch, max_cases=max_cases)
 
 
 def est_cpu_s(spec: CaseSpec) -> float:

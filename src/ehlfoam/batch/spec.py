@@ -49,12 +49,13 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, RootModel,
-                      ValidationError, model_validator)
+                      ValidationError, ValidationInfo, model_validator)
 
 from ehlfoam._io import read_toml
 from ehlfoam.errors import SpecError, format_validation_error
 
-__all__ = ["BatchSpec", "Ramp", "SpecError", "Sweep", "load_batch_spec", "parse_batch_spec"]
+__all__ = ["DEFAULT_MAX_CASES", "BatchSpec", "Ramp", "SpecError", "Sweep", "count_cases",
+           "load_batch_spec", "parse_batch_spec"]
 
 #: unknown keys refused, frozen, strict types (no true or "25" for a number); the swept
 #: values are validated by the case spec itself, strictly too
@@ -64,6 +65,10 @@ RANGE_HELP = ("a list [0.005, 0.008] or a range {start = 0.005, stop = 0.025, nu
               "(or step = 0.005; spacing = \"log\")")
 #: Keys of a range table
 RANGE_KEYS = ("start", "stop", "num", "step", "spacing")
+#: The most cases a batch may ask for unless raised (``ehlfoam batch --max-cases N``,
+#: ``BatchOptions(max_cases=N)``): counted from the spec's lists and ranges before any case
+#: is made, so that a sweep of 10^6 cases or a range of 10^9 values is refused at once.
+DEFAULT_MAX_CASES = 2000
 
 
 # ------------------------------------------------------------------ values
@@ -75,8 +80,10 @@ def _is_range(value: Any) -> bool:
     return isinstance(value, dict) and bool({"start", "stop"} & set(value))
 
 
-def _range_values(r: dict[str, Any]) -> list[float]:
-    """Expand {start, stop, num | step, spacing} (stop included)."""
+def _range_length(r: dict[str, Any]) -> int | float:
+    """How many values the range {start, stop, num | step, spacing} gives (stop included),
+    counted without making them (``math.inf`` where the count overflows); ValueError naming
+    what is wrong with the range."""
     unknown = set(r) - set(RANGE_KEYS)
     if unknown:
         raise ValueError(f"unknown range key(s) {', '.join(sorted(unknown))} "
@@ -84,8 +91,8 @@ def _range_values(r: dict[str, Any]) -> list[float]:
     if "start" not in r or "stop" not in r or ("num" in r) == ("step" in r):
         raise ValueError(f"a range needs start, stop and one of num or step ({RANGE_HELP})")
     start, stop = r["start"], r["stop"]
-    if not (_number(start) and _number(stop)):
-        raise ValueError("range start and stop must be numbers")
+    if not (_number(start) and _number(stop)) or not math.isfinite(stop - start):
+        raise ValueError("range start and stop must be finite numbers")
     spacing = r.get("spacing", "linear")
     if spacing not in ("linear", "log"):
         raise ValueError(f"range spacing = {spacing!r}: valid are 'linear' and 'log'")
@@ -97,21 +104,46 @@ def _range_values(r: dict[str, Any]) -> list[float]:
         num = r["num"]
         if not isinstance(num, int) or isinstance(num, bool) or num < 0:
             raise ValueError(f"range num = {num!r}: must be an integer >= 1")
-        if num == 0:
-            return []
-        if num == 1:
-            return [float(start)]
-        if spacing == "log":
-            lo, hi = math.log(start), math.log(stop)
-            return [math.exp(lo + (hi - lo) * k / (num - 1)) for k in range(num)]
-        return [start + (stop - start) * k / (num - 1) for k in range(num)]
+        return num
     step = r["step"]
-    if not _number(step) or step <= 0:
-        raise ValueError(f"range step = {step!r}: must be a number > 0")
+    if not _number(step) or not step > 0 or not math.isfinite(step):
+        raise ValueError(f"range step = {step!r}: must be a finite number > 0")
     if spacing == "log":
         raise ValueError("a log range takes num, not step")
-    n = int(math.floor((stop - start) / step + 1e-9)) + 1
-    return [start + k * step for k in range(n)]
+    steps = (stop - start) / step
+    return int(math.floor(steps + 1e-9)) + 1 if math.isfinite(steps) else math.inf
+
+
+def _range_values(r: dict[str, Any], max_values: int | None = None) -> list[float]:
+    """Expand {start, stop, num | step, spacing} (stop included), counted first: a range of
+    more than ``max_values`` values is refused before any is made."""
+    n = _range_length(r)
+    if max_values is not None and n > max_values:
+        raise ValueError(f"the range {_range_text(r)} gives {count_text(n)} values, more than "
+                         f"max_cases = {max_values:,} cases in all (raise it with --max-cases)")
+    start, stop = r["start"], r["stop"]
+    if n == 0:
+        return []
+    if n == 1:
+        return [float(start)]
+    if "num" in r:
+        if r.get("spacing", "linear") == "log":
+            lo, hi = math.log(start), math.log(stop)
+            return [math.exp(lo + (hi - lo) * k / (n - 1)) for k in range(n)]
+        return [start + (stop - start) * k / (n - 1) for k in range(n)]
+    return [start + k * r["step"] for k in range(n)]
+
+
+def _range_text(r: dict[str, Any]) -> str:
+    return "{" + ", ".join(f"{k} = {v!r}" for k, v in r.items()) + "}"
+
+
+def count_text(n: int | float) -> str:
+    """A count for a message: 1,000,000 up to 10^12, then its power of ten."""
+    if n == math.inf:
+        return "more than 10^308"
+    n = int(n)
+    return f"{n:,}" if n < 10**12 else f"about 10^{len(str(n)) - 1}"
 
 
 def rounded(v: float) -> float:
@@ -137,10 +169,17 @@ def flatten(table: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     return out
 
 
-def _values(raw: Any) -> list[Any]:
-    """A swept key's values: a list, a range table or a single value; floats rounded."""
+def _max_cases(info: ValidationInfo | None) -> int:
+    """The cap on the cases of a batch, from the validation's context (``max_cases``)."""
+    context = info.context if info is not None else None
+    return (context or {}).get("max_cases", DEFAULT_MAX_CASES)
+
+
+def _values(raw: Any, info: ValidationInfo | None = None) -> list[Any]:
+    """A swept key's values: a list, a range table or a single value; floats rounded. A
+    range is counted before it is made (at most the cap on the batch's cases)."""
     if _is_range(raw):
-        values = _range_values(raw)
+        values = _range_values(raw, _max_cases(info))
     elif isinstance(raw, list):
         values = raw
     else:
@@ -150,11 +189,11 @@ def _values(raw: Any) -> list[Any]:
     return [rounded(v) if isinstance(v, float) else v for v in values]
 
 
-def _ramp_speeds(raw: Any) -> list[float]:
+def _ramp_speeds(raw: Any, info: ValidationInfo) -> list[float]:
     if raw in ([], {}, None):
         raise ValueError("a ramp without speeds: give its speeds in m/s, increasing, e.g. "
                          "contact.speed = [0.005, 0.008, 0.012]")
-    values = _values(raw)
+    values = _values(raw, info)
     bad = [v for v in values if not _number(v)]
     if bad:
         raise ValueError(f"{bad[0]!r} is not a number ({RANGE_HELP})")
@@ -196,6 +235,71 @@ def _case_keys(table: dict[str, Any]) -> dict[str, Any]:
         if key == "supply" and any(not isinstance(v, dict) for v in items):
             raise ValueError(f"supply = {value!r}: {_SUPPLY_HELP}")
     return flat
+
+
+# ------------------------------------------------------------------ counting
+def _value_count(raw: Any) -> int | float:
+    """How many values a swept key's raw value gives, without making them (a range that is
+    not valid counts 1: its validation says what is wrong)."""
+    if _is_range(raw):
+        try:
+            return _range_length(raw)
+        except (ValueError, TypeError):
+            return 1
+    return len(raw) if isinstance(raw, list) else 1
+
+
+_RAMP_OWN = ("name", "branches", "start_from", "fixed", "speeds")
+
+
+def count_cases(data: Any) -> tuple[int | float, list[str]]:
+    """How many cases raw batch spec data asks for, and where they come from, counted from
+    its lists and ranges without expanding them: each sweep's product of value counts, each
+    ramp's steps (a case met twice counts twice: the plan may be smaller). Parts that are
+    not valid count as little as they can; validation reports them."""
+    if not isinstance(data, dict):
+        return 0, []
+    sweeps = data.get("sweep", [])
+    sweeps = [sweeps] if isinstance(sweeps, dict) else sweeps
+    total: int | float = 0
+    parts: list[str] = []
+    for k, table in enumerate(sweeps if isinstance(sweeps, list) else []):
+        try:
+            flat = flatten(table) if isinstance(table, dict) else {}
+        except (ValueError, TypeError):
+            continue
+        counts = {key: _value_count(v) for key, v in flat.items()}
+        n = math.prod(counts.values()) if counts else 0
+        total += n
+        factors = [f"{count_text(c)} {key}" for key, c in counts.items() if c != 1]
+        where = f"sweep[{k}]" if len(sweeps) > 1 else "sweep"
+        parts.append(f"{where}: " + (" x ".join(factors) if factors else "1")
+                     + (f" = {count_text(n)}" if len(factors) > 1 else ""))
+    ramps = data.get("ramp", [])
+    for r in ramps if isinstance(ramps, list) else []:
+        if not isinstance(r, dict):
+            continue
+        try:
+            flat = flatten({k: v for k, v in r.items() if k not in _RAMP_OWN})
+        except (ValueError, TypeError):
+            flat = {}
+        speeds = _value_count(flat.get("contact.speed", r.get("speeds", [])))
+        n = speeds if r.get("branches") in ("up", "down") else max(2 * speeds - 1, 0)
+        total += n
+        parts.append(f"ramp {r.get('name', '?')!s}: {count_text(n)} steps")
+    return total, parts
+
+
+def check_count(data: Any, max_cases: int) -> None:
+    """Refuse batch spec data that asks for more than ``max_cases`` cases (counted, not
+    expanded), naming the count and where it comes from."""
+    n, parts = count_cases(data)
+    if n > max_cases:
+        raise ValueError(
+            f"the batch asks for {count_text(n)} cases ({'; '.join(parts)}), more than "
+            f"max_cases = {max_cases:,} (valid: at most max_cases cases, counted before any is "
+            f"made): sweep fewer values, or raise the cap with --max-cases N "
+            f"(BatchOptions(max_cases=N))")
 
 
 # ------------------------------------------------------------------ models
@@ -286,7 +390,8 @@ class BatchSpec(BaseModel):
 
     @model_validator(mode="before")
     @classmethod
-    def _sweep_table_or_list(cls, data: Any) -> Any:
+    def _sweep_table_or_list(cls, data: Any, info: ValidationInfo) -> Any:
+        check_count(data, _max_cases(info))    # before any list or range is made
         if isinstance(data, dict) and isinstance(data.get("sweep"), dict):
             data = {**data, "sweep": [data["sweep"]]}
         return data
@@ -316,19 +421,31 @@ def _single_sweep(loc: tuple) -> tuple:
     return loc[:1] + loc[2:] if loc[:2] == ("sweep", 0) else loc
 
 
-def parse_batch_spec(data: dict[str, Any], source: str = "batch spec") -> BatchSpec:
-    """Validate batch spec data; :class:`SpecError` naming the key, value and valid range."""
+def check_max_cases(max_cases: Any) -> int:
+    """``max_cases`` as the cap on a batch's cases: an integer >= 1."""
+    if isinstance(max_cases, bool) or not isinstance(max_cases, int) or max_cases < 1:
+        raise SpecError(f"--max-cases = {max_cases!r}: valid range max_cases >= 1 (an integer;"
+                        f" default {DEFAULT_MAX_CASES})")
+    return max_cases
+
+
+def parse_batch_spec(data: dict[str, Any], source: str = "batch spec",
+                     max_cases: int = DEFAULT_MAX_CASES) -> BatchSpec:
+    """Validate batch spec data; :class:`SpecError` naming the key, value and valid range.
+    A batch of more than ``max_cases`` cases is refused, counted before it is expanded
+    (:func:`count_cases`)."""
+    max_cases = check_max_cases(max_cases)
     rename = _single_sweep if isinstance(data.get("sweep"), dict) else None
     try:
-        return BatchSpec(**data)
+        return BatchSpec.model_validate(data, context={"max_cases": max_cases})
     except ValidationError as err:
         text = format_validation_error(err, BatchSpec, hints=_HINTS, rename=rename)
         raise SpecError(f"invalid {source}: {text}") from None
 
 
-def load_batch_spec(path: str | Path) -> BatchSpec:
-    """Read and validate a batch spec TOML file."""
-    spec = parse_batch_spec(read_toml(path), source=f"batch spec {path}")
+def load_batch_spec(path: str | Path, max_cases: int = DEFAULT_MAX_CASES) -> BatchSpec:
+    """Read and validate a batch spec TOML file (at most ``max_cases`` cases)."""
+    spec = parse_batch_spec(read_toml(path), source=f"batch spec {path}", max_cases=max_cases)
     if spec.name is None:
         spec = spec.model_copy(update={"name": Path(path).stem})
     return spec

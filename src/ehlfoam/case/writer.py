@@ -19,7 +19,9 @@ nothing behind, and an earlier case replaced with ``overwrite`` stays whole unti
 from __future__ import annotations
 
 import json
+import math
 import os
+import re
 import shlex
 import shutil
 import tempfile
@@ -31,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ehlfoam._io import atomic_write_json, atomic_write_text
+from ehlfoam.case.bounds import check_work
 from ehlfoam.case.dictionaries import edit_physics_dicts, edit_run_control, release_geometry
 from ehlfoam.case.fields import edit_fields, with_supply_patch
 from ehlfoam.case.geometry import META, CaseGeometry
@@ -41,6 +44,7 @@ from ehlfoam.foam.runtime import FoamRuntime
 from ehlfoam.gap.source import load_gap
 from ehlfoam.mesh import (BaseMesh, MeshParams, PolyMesh, build_base_mesh, extrude, gap_mismatch,
                           size_function, smallest_cell_size, wall_steps, write_polymesh)
+from ehlfoam.mesh.sizing import mesh_params
 from ehlfoam.spec.case import CaseSpec
 
 TEMPLATES = Path(__file__).resolve().parent / "templates"
@@ -63,32 +67,44 @@ def _edit_dicts(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:
     edit_run_control(spec, case, geom.end_time, geom.write_interval, geom.max_delta_t)
 
 
-def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int, solver: str) -> None:
-    """Fill the runtime into the hand-runnable Allrun (launch words, application folder)."""
+#: A marker of the hand-run scripts, ``@NAME@``, that :func:`_write_scripts` fills
+_MARKER = re.compile(r"@([A-Z_]+)@")
+
+
+def script_values(runtime: FoamRuntime, n_procs: int, solver: str) -> dict[str, str]:
+    """What the Allrun's markers get, each already shell-quoted: the launch words and the
+    parallel command as quoted words (:func:`shlex.join`), every other value one quoted word
+    (:func:`shlex.quote`), so that no ``$(...)``, backquote, ``;``, space or quote in a path
+    (``EHLFOAM_CACHE``, ``EHLFOAM_FOAM_PREFIX``, ``WM_PROJECT_DIR``) is expanded by the
+    shell that runs the script."""
     argv = runtime.command("APP")
     app_path = Path(argv[-1])
-    values = {"@FOAM_LAUNCH@": shlex.join(argv[:-1]),
-              "@FOAM_BIN@": str(app_path.parent) if app_path.is_absolute() else "",
-              "@WM_PROJECT_DIR@": runtime.env({}).get("WM_PROJECT_DIR", ""),
-              "@NPROCS@": str(n_procs),
-              "@SOLVER@": solver,
-              "@PARALLEL_SOLVER@": shlex.join(runtime.mpi_command(solver, n_procs, "."))
-              if n_procs > 1 else "false"}  # the serial branch runs instead
+    return {"FOAM_LAUNCH": shlex.join(argv[:-1]),
+            "FOAM_BIN": shlex.quote(str(app_path.parent) if app_path.is_absolute() else ""),
+            "WM_PROJECT_DIR": shlex.quote(runtime.env({}).get("WM_PROJECT_DIR", "")),
+            "NPROCS": shlex.quote(str(int(n_procs))),
+            "SOLVER": shlex.quote(solver),
+            "PARALLEL_SOLVER": shlex.join(runtime.mpi_command(solver, n_procs, "."))
+            if n_procs > 1 else "false"}  # the serial branch runs instead
+
+
+def _write_scripts(case: Path, runtime: FoamRuntime, n_procs: int, solver: str) -> None:
+    """Fill the runtime into the hand-runnable Allrun (launch words, application folder), in
+    one pass: a value is never searched for markers again."""
+    values = script_values(runtime, n_procs, solver)
     text = (case / "Allrun").read_text()
-    for key, value in values.items():
-        text = text.replace(key, value)
-    (case / "Allrun").write_text(text)
+    (case / "Allrun").write_text(_MARKER.sub(lambda m: values[m.group(1)], text))
 
 
 def case_mesh(spec: CaseSpec, gap) -> tuple[MeshParams, BaseMesh, PolyMesh, np.ndarray]:
     """The mesh :func:`write_case` writes for ``spec`` on the gap h(x, y) [m]: its parameters,
     the 2D base mesh, the extruded mesh with its supply patch, and the supply faces' oil
     fractions."""
-    a = spec.a
-    params = MeshParams(**spec.domain.box(a).fields(), n_layers=spec.mesh.level()["n_layers"],
-                        polar_radius=None if spec.polar_radius is None
-                        else spec.polar_radius * a)
-    base = build_base_mesh(params, size_function(spec))
+    params = mesh_params(spec)
+    # the mesher's own guard, at the spec's cap (check_work refuses the spec first, by the
+    # same estimate, naming mesh.max_cells)
+    base = build_base_mesh(params, size_function(spec),
+                           max_quads=math.ceil(spec.mesh.max_cells / params.n_layers))
     mesh, supply = with_supply_patch(spec, extrude_level(spec, base, gap))
     return params, base, mesh, supply
 
@@ -99,7 +115,9 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
     """Build the case of ``spec`` in ``out`` (atomically: built in a temporary sibling folder
     and renamed into place). ``overwrite``: ``out`` may be an earlier case the tool wrote
     (not one being run); anything else that is not empty is refused with
-    :class:`CaseExists` before any work. ``prepare`` is called with the complete temporary
+    :class:`CaseExists` before any work. A spec whose case would exceed ``mesh.max_cells``
+    or ``run.max_steps`` is refused next (:func:`ehlfoam.case.bounds.check_work`, a
+    SpecError), before the EHL precalc. ``prepare`` is called with the complete temporary
     case folder before it is renamed into place (a start from another state); if it raises,
     nothing is left and an earlier case stays as it was. Returns the case's
     :class:`CaseGeometry`."""
@@ -109,6 +127,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
                          "the mesh follows: ehlfoam case SPEC --out DIR --start-from SOURCE "
                          "(ehlfoam.seed.follow.write_started_case)")
     check_replaceable(out, overwrite)
+    check_work(spec)   # the mesh and the time steps within their caps, before the precalc
     runtime = runtime or FoamRuntime.from_environment()
     gap, precalc = load_gap(spec.contact)
     a = spec.a

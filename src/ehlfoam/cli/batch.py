@@ -1,7 +1,9 @@
 """``ehlfoam batch SPEC``: generate, run and report every case of a batch spec.
 
 Exit codes: 0 every planned case finished; 1 some case failed or is not finished; 2 bad
-input (bad spec, busy folder, a finished case with another spec; nothing built);
+input (bad spec, more cases than --max-cases, run.n_procs beyond the usable cores without
+--oversubscribe, a bad --slurm value, busy folder, a finished case with another spec;
+nothing built);
 130 interrupted (Ctrl-C / SIGTERM; re-run the command to resume).
 
 Also runs on its own: ``python -m ehlfoam.cli.batch SPEC [options]``.
@@ -51,6 +53,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     dask.add_argument("--slurm", nargs="?", const="", default=None, metavar="KEY=VALUE,...",
                       help="run on Slurm through dask-jobqueue: cores=N,memory=16GB,"
                            "walltime=01:00:00,queue=NAME,jobs=N[,account=NAME]")
+    p.add_argument("--max-cases", type=positive_int, default=None, metavar="N",
+                   help="the most cases the batch may ask for, counted before they are "
+                        "expanded (default 2000: a sweep or range that asks for more is "
+                        "refused at once)")
+    p.add_argument("--oversubscribe", action="store_true",
+                   help="run even when run.n_procs, --cores or --jobs x run.n_procs is more "
+                        "than the CPU cores this process may use (refused otherwise)")
     p.add_argument("--dry-run", action="store_true",
                    help="print the expanded plan and the estimated cost; build nothing")
     p.add_argument("--no-report", action="store_true",
@@ -90,17 +99,22 @@ def cmd_batch(args: argparse.Namespace) -> int:
     from ehlfoam.batch.executors import parse_slurm
     from ehlfoam.report import after_batch
 
+    from ehlfoam.batch.spec import DEFAULT_MAX_CASES
+
     check_batch_folder(args.spec, args.out, writes=not args.dry_run)
+    max_cases = args.max_cases or DEFAULT_MAX_CASES
     try:
-        if args.dry_run:
-            print(dry_run(args.spec, Path(args.out) if args.out else None))
-            return EXIT_OK
         slurm = parse_slurm(args.slurm) if args.slurm is not None else None
+        if args.dry_run:
+            print(dry_run(args.spec, Path(args.out) if args.out else None,
+                          max_cases=max_cases))
+            return EXIT_OK
         opts = BatchOptions(out=Path(args.out) if args.out else None, jobs=args.jobs,
                             cores=args.cores, rerun_failed=args.rerun_failed,
                             scheduler=args.scheduler, slurm=slurm, quiet=args.quiet,
                             regime=not args.no_report,
-                            report=None if args.no_report else after_batch)
+                            report=None if args.no_report else after_batch,
+                            max_cases=max_cases, oversubscribe=args.oversubscribe)
         outcome = run_batch(args.spec, opts)
     except (SpecError, BatchError) as err:
         print(f"ehlfoam batch: {err}", file=sys.stderr)

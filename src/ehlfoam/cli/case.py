@@ -96,10 +96,13 @@ def cmd_case(args: argparse.Namespace) -> int:
     from ehlfoam.paths import check_case_out
     from ehlfoam.spec.case import load_case_spec, make_case_spec
 
+    from ehlfoam.case.bounds import check_work
+
     overrides = parse_overrides(args.set)
     spec = (load_case_spec(args.spec, **overrides) if args.spec
             else make_case_spec(None, **overrides))
     check_case_out(args.out, "--out")
+    check_work(spec)   # mesh.max_cells, run.max_steps: before the precalc and the mesher
     if spec.mesh.follow is not None and not args.start_from:
         raise SpecError("mesh.follow needs --start-from (a run case, a case snapshot or a "
                         "thin-film state): the mesh follows that state's meniscus")

@@ -74,7 +74,7 @@ def add_command(subparsers, name: str, *, help: str, description: str,
 
 
 def positive_float(text: str) -> float:
-    """argparse type: a finite number > 0."""
+    """argparse type: a finite number > 0 (NaN and infinity are refused: not limits)."""
     try:
         value = float(text)
     except ValueError:

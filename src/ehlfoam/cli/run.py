@@ -2,7 +2,9 @@
 
 Exit codes: 0 finished, 1 failed or stopped short (metrics.json says why), 2 bad input (no
 such case, not a case, a corrupt case file, a path OpenFOAM cannot take, a read-only or full
-disk, or a case another process is running; found before anything is written).
+disk, a case another process is running, a limit that is not a positive finite number,
+run.n_procs above the usable cores without --oversubscribe, an extension beyond
+run.max_steps; found before anything is written).
 """
 
 from __future__ import annotations
@@ -36,6 +38,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="go on for TRANSITS transit times past the latest written time (from 0 "
                         "in a case not run yet), whatever the steady-state tests say (does "
                         "a steady state last?)")
+    p.add_argument("--oversubscribe", action="store_true",
+                   help="run even when run.n_procs is more than the CPU cores this process "
+                        "may use (refused otherwise)")
     p.add_argument("--quiet", action="store_true", help="no line per written time")
     p.set_defaults(func=cmd_run)
     return p
@@ -63,13 +68,21 @@ def cmd_run(args: argparse.Namespace) -> int:
         if not args.quiet:
             progress.console.print(sample_line(sample, geom), highlight=False, soft_wrap=True)
 
+    from ehlfoam.case.bounds import check_limit, check_wall_limit
+    from ehlfoam.errors import SpecError
+
     try:
+        if args.wall_limit is not None:   # the options by their names, before anything starts
+            check_wall_limit(args.wall_limit, "--wall-limit")
+        if args.extend is not None:
+            check_limit("--extend", args.extend, "transits")
         with progress:
             metrics = run_case(args.case, wall_limit=args.wall_limit, on_sample=on_sample,
                                extend_transits=args.extend,
                                on_note=lambda line: print(f"ehlfoam run: {line}",
-                                                          file=sys.stderr, flush=True))
-    except (CaseBusy, FileNotFoundError) as err:
+                                                          file=sys.stderr, flush=True),
+                               oversubscribe=args.oversubscribe)
+    except (CaseBusy, FileNotFoundError, SpecError) as err:
         print(f"ehlfoam run: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     print(json.dumps({k: metrics.get(k) for k in KEYS}))

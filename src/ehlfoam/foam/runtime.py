@@ -130,7 +130,17 @@ class FoamRuntime:
     # ------------------------------------------------------------ factories
     @classmethod
     def embedded(cls, root: str | os.PathLike[str]) -> FoamRuntime:
+        """The embedded runtime in ``root``. A root whose path holds what the loader's
+        library path splits at (``:``, ``;``) or what OpenFOAM strips from an application's
+        path (white space, quotes) cannot run: :class:`FoamConfigError` naming it."""
         root = Path(root).expanduser().absolute()
+        bad = sorted({c for c in str(root) if c in ":;\"'" or c.isspace()})
+        if bad:
+            raise FoamConfigError(
+                f"the embedded OpenFOAM's folder {str(root)!r} (EHLFOAM_CACHE/{EMBEDDED_DIRNAME})"
+                f" holds {' '.join(repr(c) for c in bad)}: OpenFOAM cannot run from such a path "
+                f"(valid: no white space, quotes, ':' or ';'); set EHLFOAM_CACHE to another "
+                f"folder")
         return cls(kind="embedded", root=root, project_dir=root / "usr/share/openfoam")
 
     @classmethod

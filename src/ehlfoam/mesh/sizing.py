@@ -14,6 +14,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ehlfoam.mesh.domain import MeshParams
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.mesh import RefineBand, RefineBox
 
@@ -56,6 +57,14 @@ def _band_size(band: RefineBand) -> Size:
         return band.size + REFINE_GROWTH * beyond
 
     return size
+
+
+def mesh_params(spec: CaseSpec) -> MeshParams:
+    """The mesher's parameters of ``spec``'s case [m]: its domain, layers and polar ring."""
+    a = spec.a
+    return MeshParams(**spec.domain.box(a).fields(), n_layers=spec.mesh.level()["n_layers"],
+                      polar_radius=None if spec.polar_radius is None
+                      else spec.polar_radius * a)
 
 
 def refinement_size(refinement: RefineBox | RefineBand) -> Size:

@@ -125,7 +125,8 @@ def crashed_record(case: Path, old: MetricsRecord | None = None) -> MetricsRecor
 def run_case(case: str | Path, runtime: FoamRuntime | None = None,
              wall_limit: float | None = None, on_sample: OnSample | None = None,
              extend_transits: float | None = None,
-             on_note: Callable[[str], None] | None = None) -> MetricsRecord:
+             on_note: Callable[[str], None] | None = None,
+             oversubscribe: bool = False) -> MetricsRecord:
     """Run the case in ``case`` to steady state (or a limit) and write ``metrics.json``.
 
     Restarts from the latest written time if the case ran before. With ``extend_transits``
@@ -136,14 +137,27 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
     found in the case before the run (an earlier run that was killed, a cut-short write
     removed). Returns the metrics record (as written). Raises :class:`CaseBusy` when another
     process runs the case, FileNotFoundError when ``case`` is no case folder.
+
+    Bounds (:mod:`ehlfoam.case.bounds`), checked before anything is written: ``wall_limit``
+    and ``extend_transits`` positive and finite; ``run.n_procs`` within the cores this
+    process may use unless ``oversubscribe``; an extension within ``run.max_steps``. A
+    :class:`~ehlfoam.errors.SpecError` names the one that is not.
     """
-    if extend_transits is not None and not extend_transits > 0:
-        raise ValueError(f"extend_transits = {extend_transits!r} transits: it must be > 0")
+    from ehlfoam.case.bounds import check_extension, check_limit, check_n_procs, check_wall_limit
+
+    if wall_limit is not None:
+        check_wall_limit(wall_limit)
+    if extend_transits is not None:
+        check_limit("extend_transits", extend_transits, "transits")
     path = Path(case).absolute()
     if not path.is_dir():
         raise FileNotFoundError(f"case folder {path} does not exist")
     run = _Case(path, load_spec_of(path), load_geometry(path),
                 case_fields.Structure.load(path))
+    check_n_procs(run.spec.run.n_procs, oversubscribe=oversubscribe)
+    if extend_transits is not None:
+        check_extension(run.spec, extend_transits, run.geom.transit_time,
+                        run.geom.max_delta_t)
     with hold_run_lock(path) as lock:
         crashed = crashed_record(path)
         if crashed is not None:

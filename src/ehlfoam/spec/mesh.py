@@ -193,6 +193,11 @@ class Mesh(BaseModel):
         description="A mesh that follows the meniscus of the state the case starts from "
                     "(--start-from): the level then sets the bands' cells and the wall cell, "
                     "on FOLLOW_BASE. None: the levels of RESOLUTIONS.")
+    max_cells: int = Field(
+        5_000_000, ge=1, le=10**9,
+        description="The most cells a case's mesh may have: a spec whose mesh, estimated from "
+                    "its sizes (in-plane quads x n_layers) before anything is meshed, exceeds "
+                    "it is refused with the estimate. A bound on the work, not on the result.")
 
     @field_validator("polar_radius", mode="before")
     @classmethod

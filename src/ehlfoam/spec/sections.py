@@ -325,3 +325,9 @@ class Run(BaseModel):
     n_procs: int = Field(
         1, ge=1, le=1024,
         description="MPI ranks (1: serial).")
+    max_steps: int = Field(
+        10_000_000, ge=1, le=10**12,
+        description="The most time steps a case may take to its end time: a case whose end "
+                    "time over its largest time step (the capillary limit on the smallest "
+                    "cell, or the write interval) exceeds it is refused before it is built, "
+                    "with the estimate. A bound on the work, not on the result.")
