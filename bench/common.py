@@ -20,30 +20,39 @@ from pathlib import Path
 from typing import Any
 
 
-def _child(spec_kwargs: dict, queue) -> None:
+def _child(spec_kwargs: dict, queue, workers: int | None = None) -> None:
+    import os
+
+    from ehlfoam.contact.threads import numba_threads, solve_threads
     from ehlfoam.contact.solver import solve
     from ehlfoam.contact.spec import make_spec
 
-    solve(make_spec(**{**spec_kwargs, "grid": 65, "max_cycles": 2}))  # numba's compile
-    spec = make_spec(**spec_kwargs)
-    t0 = time.perf_counter()
-    try:
-        summary = solve(spec).summary()
-    except Exception as err:  # noqa: BLE001 - a failed point of a map is data
-        summary = {"converged": False, "failure": f"{type(err).__name__}: {err}"}
-    summary["wall_s"] = time.perf_counter() - t0
+    with numba_threads(solve_threads(workers)):  # the solver's one thread setting
+        solve(make_spec(**{**spec_kwargs, "grid": 65, "max_cycles": 2}))  # numba's compile
+        spec = make_spec(**spec_kwargs)
+        t0, c0 = time.perf_counter(), time.process_time()
+        try:
+            summary = solve(spec).summary()
+        except Exception as err:  # noqa: BLE001 - a failed point of a map is data
+            summary = {"converged": False, "failure": f"{type(err).__name__}: {err}"}
+        summary["wall_s"] = time.perf_counter() - t0
+        summary["cpu_s"] = time.process_time() - c0
     summary["peak_rss_GiB"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
+    summary["load_average"] = os.getloadavg()
+    summary["threads"] = solve_threads(workers)
     queue.put(summary)
 
 
-def solve_in_subprocess(spec_kwargs: dict) -> dict:
-    """The EHL precalc of ``make_spec(**spec_kwargs)`` solved in a fresh process, so that its
-    peak memory is its own and numba's compile time is paid before the clock starts: its
-    summary plus ``wall_s`` [s] and ``peak_rss_GiB``; a solve that raised gives
-    ``converged`` False and its ``failure``."""
+def solve_in_subprocess(spec_kwargs: dict, workers: int | None = None) -> dict:
+    """The EHL precalc of ``make_spec(**spec_kwargs)`` solved in a fresh process on
+    ``workers`` threads (default: the solver's own choice), so that its peak memory is its own
+    and numba's compile time is paid before the clock starts: its summary plus ``wall_s`` [s],
+    ``cpu_s`` [s] (the process's CPU time, all threads), ``peak_rss_GiB`` and the machine's
+    ``load_average`` at the end (timings on a shared machine are noisy); a solve that raised
+    gives ``converged`` False and its ``failure``."""
     ctx = mp.get_context("spawn")
     queue = ctx.Queue()
-    proc = ctx.Process(target=_child, args=(spec_kwargs, queue))
+    proc = ctx.Process(target=_child, args=(spec_kwargs, queue, workers))
     proc.start()
     out = queue.get()
     proc.join()

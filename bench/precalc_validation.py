@@ -1,7 +1,7 @@
 """The EHL precalc against classic results: Hertz, Nijenbanning-Venner-Moes, Hamrock-Dowson.
 
     python bench/precalc_validation.py [--stability [--stability-grid 257|default]]
-        [--out FILE.json]
+        [--accuracy] [--twophase] [--workers N] [--out FILE.json]
     python bench/precalc_validation.py --quick
 
 1. Dry limit: the solver's elastic kernel with no film (Polonsky-Keer) against Hertz's
@@ -12,12 +12,19 @@
 3. The reference experiment's conditions (HVI60, 20 N, 40 C, u = 2..40 mm/s) with the
    default laws (Roelands, Dowson-Higginson) and with the formula's, beside NVM and
    Hamrock-Dowson.
-4. The two-phase cavitation option at 20 mm/s, 25 C, 20 N: the sub-ambient length l / a.
+4. The two-phase cavitation option at 20 mm/s, 25 C, 20 N on 257 points along y (513 x
+   257): the sub-ambient length and the more-than-half-gas length over a, beside the thesis
+   model's 0.9 a; with ``--twophase``, on three grids up to its default (2049 x 1025),
+   each with its time and peak memory.
 5. With ``--stability``: converged / stagnated / failed over M = 10..3e4 x L = 0..20 on
    ``--stability-grid`` points a side (``default``: the solver's own grid).
+6. With ``--accuracy``: the 18-point table (5 / 20 / 30 N x 25 / 40 / 60 C, each at 10 mm/s
+   and at 2 or 40 mm/s: Moes M 343-34,215) on the default grids, hc beside the solver of
+   main 5ad327e (before the full multigrid of issue 77), cycles, wall and CPU time.
 
-Each solve runs in a fresh process. ``--quick``: the dry limit and four NVM points at
-M <= 100 on 129 points a side (seconds).
+Each solve runs in a fresh process, on ``--workers`` threads (default: the solver's own
+choice). ``--quick``: the dry limit and four NVM points at M <= 100 on 129 points a side
+(seconds); with ``--twophase``, the grids 129-513 along y.
 """
 
 from __future__ import annotations
@@ -38,6 +45,17 @@ STABILITY_M = (10, 30, 100, 300, 1000, 3000, 10000, 30000)
 STABILITY_L = (0, 2, 5, 10, 20)
 #: the formula's laws: the problem depends on M and L only
 MOES_LAWS = dict(viscosity="barus", density="incompressible")
+#: hc [nm] of the accuracy points, (load N, temperature C, speed m/s), by the solver of main
+#: 5ad327e (2026-12-06: fixed residual 3e-5, speed ramps above M 5000; a busy 2-core
+#: machine, 1477 s wall, 825 s CPU for the 18): the reference of "hc unchanged within 0.5 %".
+HC_MAIN_5AD327E_NM = {
+    (5, 25, 0.01): 14.9042, (5, 25, 0.002): 5.0311, (5, 40, 0.01): 8.9275,
+    (5, 40, 0.04): 22.7483, (5, 60, 0.01): 5.2491, (5, 60, 0.002): 1.7910,
+    (20, 25, 0.01): 12.6917, (20, 25, 0.04): 33.0326, (20, 40, 0.01): 7.5254,
+    (20, 40, 0.002): 2.4738, (20, 60, 0.01): 4.3620, (20, 60, 0.04): 11.2881,
+    (30, 25, 0.01): 12.0693, (30, 25, 0.002): 3.9311, (30, 40, 0.01): 7.1236,
+    (30, 40, 0.04): 18.6154, (30, 60, 0.01): 4.1037, (30, 60, 0.002): 1.2994,
+}
 
 
 def dry(n: int) -> dict:
@@ -58,17 +76,17 @@ def moes_spec(M: float, L: float, grid: int | None) -> dict:
                 **MOES_LAWS)
 
 
-def nvm(M: float, L: float, grid: int) -> dict:
+def nvm(M: float, L: float, grid: int, workers: int | None = None) -> dict:
     """One (M, L) point against NVM's formula."""
-    s = solve_in_subprocess(moes_spec(M, L, grid))
+    s = solve_in_subprocess(moes_spec(M, L, grid), workers)
     return dict(M=M, L=L, grid=grid, hc_over_nvm=s["hc_m"] / s["hc_nvm_m"],
                 converged=bool(s["converged"]), wall_s=s["wall_s"])
 
 
-def reference(u: float, laws: dict) -> dict:
+def reference(u: float, laws: dict, workers: int | None = None) -> dict:
     """The reference experiment's contact at u [m/s] under ``laws`` beside NVM and HD."""
     spec = dict(load=20.0, speed=u, temperature=40.0, **laws)
-    s = solve_in_subprocess(spec)
+    s = solve_in_subprocess(spec, workers)
     hd_c, _ = hamrock_dowson(make_spec(**spec).contact())
     return dict(u_mm_s=u * 1e3, laws="Barus, incompressible" if laws else "default",
                 M=s["M"], L=s["L"], grid=s["grid"], hc_nm=s["hc_m"] * 1e9,
@@ -77,10 +95,49 @@ def reference(u: float, laws: dict) -> dict:
                 converged=bool(s["converged"]), wall_s=s["wall_s"])
 
 
-def stability(M: float, L: float, grid: int | None) -> dict:
+def accuracy(workers: int | None) -> dict:
+    """The 18 points of :data:`HC_MAIN_5AD327E_NM` on their default grids: hc against main
+    5ad327e's, cycles and cost."""
+    rows = []
+    for (F, T, u), before in HC_MAIN_5AD327E_NM.items():
+        s = solve_in_subprocess(dict(load=float(F), temperature=float(T), speed=u),
+                                workers=workers)
+        hc = s["hc_m"] * 1e9
+        rows.append(dict(load_N=F, temperature_C=T, speed_mm_s=u * 1e3, M=s["M"], L=s["L"],
+                         grid=s["grid"], hc_nm=hc, hc_main_nm=before, diff=hc / before - 1.0,
+                         cycles=s["cycles"], wall_s=s["wall_s"], cpu_s=s["cpu_s"],
+                         converged=bool(s["converged"]), ramp=bool(s.get("continuation_M"))))
+    total = dict(wall_s=sum(r["wall_s"] for r in rows), cpu_s=sum(r["cpu_s"] for r in rows))
+    return dict(rows=rows, largest_diff=max(abs(r["diff"]) for r in rows), **total,
+                workers=workers)
+
+
+def twophase(grids: tuple[int, ...], workers: int | None) -> list[dict]:
+    """The two-phase option at 20 mm/s, 25 C, 20 N on ``grids`` (points along y; x has
+    2n - 1): sub-ambient and more-than-half-gas lengths over a, time and peak memory."""
+    rows = []
+    for n in grids:
+        s = solve_in_subprocess(dict(load=20.0, speed=0.02, temperature=25.0,
+                                     cavitation="twophase", grid=n), workers=workers)
+        rows.append(dict(grid=s.get("grid", n), converged=bool(s["converged"]),
+                         cavity_over_a=s.get("cavity_length_over_a"),
+                         half_gas_over_a=s.get("cavity_half_density_length_over_a"),
+                         reaches_outlet=s.get("cavity_reaches_outlet"),
+                         p_min_Pa=s.get("p_min_Pa"), wall_s=s["wall_s"], cpu_s=s["cpu_s"],
+                         peak_GiB=s["peak_rss_GiB"], failure=s.get("failure")))
+    return rows
+
+
+TWOPHASE_COLUMNS = [("grid", "grid", "d"), ("cavity_over_a", "sub-ambient l/a", ".3f"),
+                    ("reaches_outlet", "to outlet", ""), ("half_gas_over_a", "half-gas l/a", ".3f"),
+                    ("converged", "converged", ""), ("wall_s", "wall [s]", ".0f"),
+                    ("cpu_s", "CPU [s]", ".0f"), ("peak_GiB", "peak [GiB]", ".2f")]
+
+
+def stability(M: float, L: float, grid: int | None, workers: int | None = None) -> dict:
     """One point of the stability map: converged, stagnated (within ten times the residual
     tolerance) or failed."""
-    s = solve_in_subprocess(moes_spec(M, L, grid))
+    s = solve_in_subprocess(moes_spec(M, L, grid), workers)
     res = s.get("residual")
     status = ("converged" if s["converged"] else
               "stagnated" if res is not None and res < 10 * 3e-5 else "failed")
@@ -95,6 +152,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--stability", action="store_true", help="also the stability map")
     ap.add_argument("--stability-grid", default="257",
                     help="points a side of the map, or 'default' (the solver's own)")
+    ap.add_argument("--accuracy", action="store_true",
+                    help="also the 18-point table against main 5ad327e's hc")
+    ap.add_argument("--twophase", action="store_true",
+                    help="the two-phase option on three grids up to its default")
+    ap.add_argument("--workers", type=int, default=None, help="threads of each solve")
     add_output_options(ap)
     args = ap.parse_args(argv)
     q = args.quick
@@ -103,27 +165,30 @@ def main(argv: list[str] | None = None) -> int:
                              ("max_err_r_lt_095", "max |P - Hertz| r<0.95a", ".2e"),
                              ("load_error", "load error", ".1e")], "1. dry limit vs Hertz")
     points = [(M, L) for M, L in NVM_POINTS if M <= 100] if q else NVM_POINTS
-    out["nvm"] = [nvm(M, L, 129 if q else 513) for M, L in points]
+    out["nvm"] = [nvm(M, L, 129 if q else 513, args.workers) for M, L in points]
     print_table(out["nvm"], [("M", "M", "g"), ("L", "L", "g"), ("grid", "grid", "d"),
                              ("hc_over_nvm", "hc / NVM", ".4f"), ("converged", "converged", ""),
                              ("wall_s", "wall [s]", ".1f")], "2. NVM, Barus + incompressible")
     if not q:
-        out["reference"] = [reference(u, laws) for laws in ({}, MOES_LAWS) for u in SPEEDS]
+        out["reference"] = [reference(u, laws, args.workers)
+                            for laws in ({}, MOES_LAWS) for u in SPEEDS]
         print_table(out["reference"], [
             ("u_mm_s", "u [mm/s]", "g"), ("laws", "laws", ""), ("M", "M", ".0f"),
             ("L", "L", ".2f"), ("grid", "grid", "d"), ("hc_nm", "hc [nm]", ".2f"),
             ("hc_nvm_nm", "NVM [nm]", ".2f"), ("hc_hd_nm", "HD [nm]", ".2f"),
             ("hc_over_nvm", "hc / NVM", ".3f"), ("hmin_nm", "hmin [nm]", ".2f"),
             ("converged", "converged", "")], "3. reference conditions (HVI60, 20 N, 40 C)")
-        s = solve_in_subprocess(dict(load=20.0, speed=0.02, temperature=25.0,
-                                     cavitation="twophase", grid=257))
-        out["twophase"] = dict(cavity_length_over_a=s.get("cavity_length_over_a"),
-                               p_min_Pa=s.get("p_min_Pa"), converged=bool(s["converged"]))
-        print(f"4. two-phase, 20 mm/s, 25 C, 20 N, 257 points: l / a = "
-              f"{out['twophase']['cavity_length_over_a']}, converged {s['converged']}")
+        out["twophase"] = twophase((257,), args.workers)
+        print_table(out["twophase"], TWOPHASE_COLUMNS,
+                    "4. two-phase, 20 mm/s, 25 C, 20 N (thesis model: 0.9 a)")
+    if args.twophase:
+        out["twophase_grids"] = twophase((129, 257, 513) if q else (257, 513, 1025),
+                                         args.workers)
+        print_table(out["twophase_grids"], TWOPHASE_COLUMNS,
+                    "4. two-phase on three grids, 20 mm/s, 25 C, 20 N (thesis model: 0.9 a)")
     if args.stability:
         grid = None if args.stability_grid == "default" else int(args.stability_grid)
-        rows = [stability(M, L, grid) for L in STABILITY_L for M in STABILITY_M]
+        rows = [stability(M, L, grid, args.workers) for L in STABILITY_L for M in STABILITY_M]
         out["stability"] = {"grid": args.stability_grid, "points": rows}
         print_table(rows, [("M", "M", "g"), ("L", "L", "g"), ("grid", "grid", "d"),
                            ("status", "status", ""), ("cycles", "cycles", "d"),
@@ -131,6 +196,17 @@ def main(argv: list[str] | None = None) -> int:
                     f"5. stability map, grid {args.stability_grid}")
         for status in ("converged", "stagnated", "failed"):
             print(f"{status}: {sum(r['status'] == status for r in rows)}/{len(rows)}")
+    if args.accuracy:
+        out["accuracy"] = acc = accuracy(args.workers)
+        print_table(acc["rows"], [
+            ("load_N", "F [N]", "g"), ("temperature_C", "T [C]", "g"),
+            ("speed_mm_s", "u [mm/s]", "g"), ("M", "M", ".0f"), ("L", "L", ".2f"),
+            ("grid", "grid", "d"), ("hc_nm", "hc [nm]", ".4f"),
+            ("hc_main_nm", "5ad327e [nm]", ".4f"), ("diff", "diff", "+.2%"),
+            ("cycles", "cycles", "d"), ("wall_s", "wall [s]", ".1f"), ("cpu_s", "CPU [s]", ".1f"),
+            ("converged", "converged", "")], "6. accuracy, 18 points against main 5ad327e")
+        print(f"largest |hc - 5ad327e| / 5ad327e = {acc['largest_diff']:.2%}; total "
+              f"{acc['wall_s']:.0f} s wall, {acc['cpu_s']:.0f} s CPU")
     write_out(args.out, out)
     return 0
 

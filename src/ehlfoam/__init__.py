@@ -96,9 +96,13 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, *,
 
 def read_metrics(case_dir: str | os.PathLike) -> MetricsRecord:
     """The metrics record of a run case (its ``metrics.json``; ``record["state"]``,
-    ``record.state``). Raises FileNotFoundError when it has none (not run)."""
+    ``record.state``). A record that a killed run left saying ``running`` (no process holds
+    the case's run lock) is first rewritten as ``interrupted`` (end_reason
+    ``monitor_killed``). Raises FileNotFoundError when it has none (not run)."""
     from ehlfoam.metrics.record import read_metrics as _read
+    from ehlfoam.run.monitor import settle_killed_run
 
+    settle_killed_run(case_dir)
     return _read(case_dir)
 
 

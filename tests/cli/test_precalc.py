@@ -187,6 +187,7 @@ BAD = [
      "eta0", "-0.02", ["greater than 0"]),
     (["--lubricant", "FOO"], "lubricant", "FOO", ["HVI60", "custom"]),
     (["--temperature", "80"], "temperature", "80", ["25", "60"]),
+    (["--temperature", "500"], "temperature", "500", ["HVI60", "25 to 60 C"]),
     (["--grid", "100"], "grid", "100", ["2**k + 1", "65", "8193"]),
     (["--grid", "33"], "grid", "33", ["2**k + 1", "65", "8193"]),
     (["--load", "abc"], "load", "abc", ["not a number", "0 < load <= 100000 N"]),
@@ -210,6 +211,14 @@ def test_bad_input_exit_2_nothing_written(tmp_path, capsys, argv, name, value, w
         assert w in err, (w, err)
     assert stdout == ""
     assert not out.exists()
+
+
+def test_temperature_error_names_the_oil_range_only(tmp_path, capsys):
+    """Beyond the field's generic bounds (-40 to 300 C) the message still gives the oil's own
+    table range, not the generic one."""
+    rc, _, err = run_cli(capsys, "--temperature", "500", "--out", tmp_path / "out")
+    assert rc == 2
+    assert "valid range 25 to 60 C" in err and "300" not in err, err
 
 
 def test_bad_input_leaves_existing_out_untouched(tmp_path, capsys):

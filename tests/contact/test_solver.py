@@ -121,22 +121,32 @@ def test_high_pressure_viscosity_light_load_converges():
     _, r, s = _solve_moes(10, 20)
     assert r.converged, s["failure"]
     assert np.all(np.isfinite(r.mg.P))
-    assert s["residual"] < 3e-5 and s["load_error"] < 3e-5
+    assert s["residual"] < 1e-3 and s["load_error"] < 3e-5
     assert s["hc_m"] == pytest.approx(s["hc_nvm_m"], rel=0.1)
     assert 0 < s["hmin_m"] < s["hc_m"]
 
 
 @pytest.mark.slow
 def test_stalled_large_L_solve_switches_relaxation_and_converges():
-    """M = 100, L = 20 on 513^2 (alpha pH ~ 34): the standard cycles fall into a limit
-    cycle at a residual of ~2e-4 where the spike's side lobes end; the stalled-solve
-    relaxation (half the Jacobi factor, more fine sweeps, limited coarse corrections)
-    converges."""
-    _, r, s = _solve_moes(100, 20, grid=513)
+    """M = 100, L = 20 on 257^2 (alpha pH ~ 34) with the distributive-Jacobi factor of the
+    small-L contacts (0.5, not the 0.2 used above L = 15): the cycles fall into a limit cycle
+    where the spike's side lobes end; the stalled-solve relaxation (half the Jacobi factor,
+    more fine sweeps, limited coarse corrections) takes over within the same solve and
+    converges, without a restart or a speed ramp."""
+    from ehlfoam.contact.multigrid import SolverOptions
+
+    c = contact_from_moes(100, 20)
+    spec = make_spec(load=c.load, speed=c.speed, lubricant="custom", eta0=c.eta0, alpha=c.alpha,
+                     rho0=870.0, radius=c.radius, modulus=c.modulus, viscosity="barus",
+                     density="incompressible", grid=257)
+    r = solve(spec, SolverOptions(high_L=100.0))
+    s = r.summary()
     assert s["stalled_at_cycle"] is not None
     assert r.converged, s["failure"]
-    assert s["residual"] < 3e-5 and s["load_error"] < 3e-5
+    assert s["continuation_M"] == []
+    assert s["residual"] < 1e-3 and s["load_error"] < 3e-5
     assert s["hc_m"] == pytest.approx(s["hc_nvm_m"], rel=0.1)
+    assert s["hc_m"] == pytest.approx(solve(spec).summary()["hc_m"], rel=2e-3)
 
 
 def test_stall_detection_compares_successive_windows():
@@ -179,6 +189,62 @@ def test_viscosity_step_limiter_scales_large_steps_only():
     assert (P[1] - 1.0) * slope == pytest.approx(2.0, rel=1e-9)
 
 
+@pytest.mark.parametrize("kw", [dict(load=20, speed=0.5, temperature=40),
+                                dict(load=20, speed=0.05, temperature=40)],
+                         ids=["M210", "M1180"])
+def test_film_criterion_stops_at_the_converged_film(kw):
+    """The default stop (the film no longer changes, a fraction of the discretisation error
+    the FMG levels estimate) gives hc within 0.2 % and hmin within 2 % (it converges more
+    slowly) of a solve to a residual of 1e-7."""
+    from ehlfoam.contact.multigrid import SolverOptions
+
+    spec = make_spec(**kw, grid=129)
+    r = solve(spec)
+    tight = solve(spec, SolverOptions(residual_only=1e-7, tol_load=1e-9, film_rel_max=0.0,
+                                      film_rel_min=0.0, max_cycles=300))
+    assert r.converged and tight.converged
+    assert tight.mg.cycles > r.mg.cycles
+    s, t = r.summary(), tight.summary()
+    assert s["hc_m"] == pytest.approx(t["hc_m"], rel=2e-3)
+    assert s["hmin_m"] == pytest.approx(t["hmin_m"], rel=2e-2)
+
+
+def test_fmg_hc_approaches_the_richardson_value():
+    """hc on 129 and 257 points a side against the Richardson value of 65-129-257 (second
+    order): the finer grid is the closer, within the 2 % that the default grids promise for
+    M < 300."""
+    kw = dict(load=20, speed=0.5, temperature=40)
+    hc = [solve(make_spec(**kw, grid=n)).summary()["hc_m"] for n in (129, 257, 513)]
+    rich = hc[2] + (hc[2] - hc[1]) / 3.0
+    errors = [abs(h / rich - 1.0) for h in hc]
+    assert errors[0] > errors[1] > errors[2]
+    assert errors[2] < 0.02
+    order = math.log2(abs(hc[1] - hc[0]) / abs(hc[2] - hc[1]))
+    assert 1.5 < order < 2.5
+
+
+def test_work_per_grid_doubling_does_not_grow():
+    """Full multigrid: the work in finest-grid sweeps stays flat (here it falls: the coarse
+    levels' fixed work is spread over more points) from 129 to 257 to 513 points a side, i.e.
+    the cost per doubling is ~4x the points, not more."""
+    kw = dict(load=20, speed=0.5, temperature=40)
+    work = [solve(make_spec(**kw, grid=n)).mg.work_units for n in (129, 257, 513)]
+    assert work[1] <= 1.1 * work[0] and work[2] <= 1.1 * work[1]
+    assert work[2] < 60
+
+
+def test_start_from_a_neighbouring_solution():
+    """A solve started from another speed's solution (cycles only, no FMG) reaches the same
+    hc as the full multigrid start."""
+    from ehlfoam.contact.solver import Start
+
+    spec = make_spec(load=20, speed=0.05, temperature=40, grid=129)
+    nb = solve(make_spec(load=20, speed=0.04, temperature=40, grid=129))
+    r = solve(spec, start=Start.from_result(nb))
+    assert r.converged and r.mg.fmg_hc == []
+    assert r.summary()["hc_m"] == pytest.approx(solve(spec).summary()["hc_m"], rel=2e-3)
+
+
 def test_non_converging_run_is_reported():
     r = solve(make_spec(load=20, speed=0.01, temperature=40, grid=65, max_cycles=1))
     s = r.summary()
@@ -204,13 +270,17 @@ def test_twophase_cavitation(speed):
     assert math.isfinite(cav) and 0.0 < cav <= 5.0
 
 
-@pytest.mark.xfail(strict=True, reason="known open problem: the two-phase density law stalls "
-                   "the multigrid cycles (relative residual ~2e-2, load error ~1e-3)")
 def test_twophase_cavitation_converges():
+    """The two-phase option as solved (the contact by multigrid with p >= 0, then the
+    sub-ambient field by Newton with the film held) converges, load balanced, with the
+    Newton's quadratic end (a handful of iterations from its flow-continuity start). The
+    two-phase density inside the multigrid cycles still stalls (residual ~3e-2)."""
     r = solve(make_spec(load=20, speed=1.0, temperature=40, grid=65, cavitation="twophase",
                         max_cycles=40))
     assert r.converged
     assert r.summary()["load_error"] < 1e-4
+    assert r.subambient.converged and r.subambient.residual < 1e-8
+    assert r.subambient.iterations < 40
 
 
 @pytest.mark.slow

@@ -34,6 +34,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import ehlfoam
+
 from ehlfoam.batch.folder import case_status, lock_is_held
 from ehlfoam.batch.results import read_results
 from ehlfoam.case.geometry import META
@@ -339,12 +341,16 @@ def _after_run_kill(tmp: Path, case: Path, tree: dict[int, int], moment: str) ->
     raw = json.loads((case / "metrics.json").read_text())["status"]
     assert load_case(case).status == "interrupted"          # what the report says
     assert case_status(case) == "interrupted"               # what the batch says
+    ehlfoam.read_metrics(case)                      # the public reader settles the file:
+    settled = json.loads((case / "metrics.json").read_text())
+    assert settled["status"] == "interrupted", settled
     resume = cli("run", "case", "--quiet", "--wall-limit", "2", cwd=tmp)
     m = json.loads((case / "metrics.json").read_text())
     assert m["status"] == "finished" and m["end_reason"] == "wall_limit", m
     matrix = (f"{moment}: processes left 0, run lock free, metrics.json {raw!r} read as "
               f"interrupted (monitor_killed), resume exit {resume.returncode}")
-    return Result(resume.returncode, resume.stderr, tree, [tmp], matrix)
+    return Result(resume.returncode, f"{settled['end_reason']}: {settled['reason']}\n"
+                  f"{resume.stderr}", tree, [tmp], matrix)
 
 
 def run_sigkill_serial(tmp: Path, lab: Lab) -> Result:

@@ -194,6 +194,8 @@ def test_running_and_never_run_cases(finished_case, tmp_path):
     # no process holds the lock: the run was killed and left metrics.json running
     html = report_case(running, animate=False).read_text()
     assert "Status: interrupted" in html and "monitor_killed" in html
+    settled = json.loads((running / "metrics.json").read_text())   # and metrics.json says so
+    assert (settled["status"], settled["end_reason"]) == ("interrupted", "monitor_killed")
 
     fresh = _copy(finished_case, tmp_path / "fresh")
     for _, folder in time_folders(fresh):

@@ -75,8 +75,12 @@ def test_a_bad_value_is_refused_with_the_range_in_its_unit(overrides, text):
 def test_the_precalc_reads_its_units_from_the_fields():
     assert valid_range("load") == "valid range 0 < load <= 100000 N"
     assert valid_range("tol_load") == "valid range 0 < tol_load < 1"
+    # a custom oil has no table: the field's own range, in its unit
     with pytest.raises(SpecError,
                        match=r"temperature = 400.0: .*valid range -40 <= temperature <= 300 C"):
+        make_spec(temperature=400.0, lubricant="custom", eta0=0.02, alpha=2e-8, rho0=870.0)
+    # a tabulated oil: its table's range, not the field's (issue 77)
+    with pytest.raises(SpecError, match=r"outside the HVI60 table: valid range 25 to 60 C"):
         make_spec(temperature=400.0)
     assert {unit_of(PrecalcSpec.model_fields[k]) for k in ("eta0", "alpha", "rho0")} \
         == {"Pa s", "1/Pa", "kg/m3"}

@@ -38,10 +38,11 @@ _LAYERS = ("supply.disc_layer", "supply.ball_layer")
 #: Rough cost model for ordering (longest first) and the first ETA: CPU seconds per simulated
 #: millisecond per resolution level, measured with the time-step defaults of 2026-11-23 (fine
 #: scaled from the earlier defaults by the medium level's factor), plus a fixed build cost and
-#: the EHL precalc of a new contact (docs/batches.md#cost-model).
+#: the EHL precalc of a new contact (docs/batches.md#cost-model; 18 points over 5-30 N,
+#: 25-60 C, 2-100 mm/s took 226 CPU s in all on one thread, 6-47 s each).
 CPU_PER_SIMULATED_MS = {"coarse": 0.17, "medium": 0.75, "fine": 3.0}
 BUILD_CPU_S = 5.0
-PRECALC_CPU_S = 60.0
+PRECALC_CPU_S = 15.0
 
 
 @dataclass(frozen=True)

@@ -44,31 +44,54 @@ def influence_coefficients(dx: np.ndarray, dy: np.ndarray, hx: float, hy: float)
     return ELASTIC_PREFACTOR * val
 
 
+def _even_extension(kernel: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """The kernel K(|d|) of a (ny, nx) grid as a circulant of ``size`` (at most 2n a side):
+    entry m along an axis holds K(min(m, size - m)) (offsets d and d - size alias), zero
+    where that offset is beyond the grid (m = n of a 2n circulant)."""
+    padded = np.zeros((kernel.shape[0] + 1, kernel.shape[1] + 1))
+    padded[:-1, :-1] = kernel
+    iy = np.arange(size[0])
+    ix = np.arange(size[1])
+    iy = np.minimum(iy, size[0] - iy)
+    ix = np.minimum(ix, size[1] - ix)
+    return padded[iy[:, None], ix[None, :]]
+
+
 class Deformation:
     """DC-FFT deformation operator on one uniform (ny, nx) grid.
 
-    ``op(P)`` returns W on the same grid; the kernel spectrum is computed once.
+    ``op(P)`` returns W on the same grid; the kernel spectrum is computed once. A pressure
+    that vanishes on the first row and the first column (the solver's Dirichlet inlet and
+    side boundary) needs a circulant of only 2(n - 1) points a side (offsets from -(n - 1)
+    to n - 2 occur), a power of two on the solver's 2^k + 1 grids; any other pressure uses
+    2n. The zero padding is skipped axis by axis (half the rows transformed), and the
+    kernel's spectrum is real (the kernel is even). ``workers``: threads of scipy.fft.
     """
 
-    def __init__(self, nx: int, ny: int, hx: float, hy: float, workers: int = -1):
+    def __init__(self, nx: int, ny: int, hx: float, hy: float, workers: int = 1):
         self.nx, self.ny, self.hx, self.hy = nx, ny, hx, hy
         self.workers = workers
         kx = np.arange(nx) * hx
         ky = np.arange(ny) * hy
         self.kernel = influence_coefficients(kx[None, :], ky[:, None], hx, hy)
-        ext = np.zeros((2 * ny, 2 * nx))
-        ext[:ny, :nx] = self.kernel
-        ext[ny + 1 :, :nx] = self.kernel[:0:-1, :]
-        ext[:ny, nx + 1 :] = self.kernel[:, :0:-1]
-        ext[ny + 1 :, nx + 1 :] = self.kernel[:0:-1, :0:-1]
-        self.shape = ext.shape
-        self.kernel_hat = sfft.rfft2(ext, workers=workers)
+        self._spectra: dict[tuple[int, int], np.ndarray] = {}
+
+    def _spectrum(self, size: tuple[int, int]) -> np.ndarray:
+        if size not in self._spectra:
+            ext = _even_extension(self.kernel, size)
+            self._spectra[size] = sfft.rfft2(ext, workers=self.workers).real.copy()
+        return self._spectra[size]
 
     def __call__(self, p: np.ndarray) -> np.ndarray:
         """Deformation W (units a**2/R) of the pressure field ``p`` (units pH), shape (ny, nx)."""
-        ph = sfft.rfft2(p, s=self.shape, workers=self.workers)
-        w = sfft.irfft2(ph * self.kernel_hat, s=self.shape, workers=self.workers)
-        return w[: self.ny, : self.nx]
+        ny, nx, w = self.ny, self.nx, self.workers
+        zero_edges = ny > 1 and nx > 1 and not (p[0, :].any() or p[:, 0].any())
+        size = (2 * (ny - 1), 2 * (nx - 1)) if zero_edges else (2 * ny, 2 * nx)
+        t = sfft.rfft(p, n=size[1], axis=1, workers=w)
+        t = sfft.fft(t, n=size[0], axis=0, workers=w, overwrite_x=True)
+        t *= self._spectrum(size)
+        t = sfft.ifft(t, axis=0, workers=w, overwrite_x=True)[:ny]
+        return sfft.irfft(t, n=size[1], axis=1, workers=w)[:, :nx]
 
 
 @njit(parallel=True, cache=True)

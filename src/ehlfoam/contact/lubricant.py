@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit, prange
 
 #: Roelands reference constants (Roelands 1966): eta_inf = 6.31e-5 Pa s (ln -> -9.67), p0.
 ROELANDS_LN_ETA_INF = -9.67
@@ -89,19 +90,36 @@ class PressureLaws:
     density: str = "dowson-higginson"
     twophase_p_scale: float | None = None
 
+    def kernel_params(self) -> np.ndarray:
+        """The laws as the parameter vector of the numba kernels (:func:`coefficients`)."""
+        lub = self.lubricant
+        roelands = self.viscosity != "barus"
+        return np.array([
+            self.p_hertz,
+            1.0 if roelands else 0.0,
+            lub.alpha,
+            np.log(lub.eta0) - ROELANDS_LN_ETA_INF,
+            lub.roelands_z if roelands else 0.0,
+            0.0 if self.density == "incompressible" else 1.0,
+            self.p_hertz / self.twophase_p_scale if self.twophase_p_scale is not None else 0.0,
+        ])
+
+    def evaluate(self, P: np.ndarray, H: np.ndarray | None = None, lam: float = 1.0):
+        """(rho, drho, eps, deps, ln_eta) at dimensionless pressure P and film H (see
+        :func:`coefficients`; without H, eps and deps are 0)."""
+        P = np.ascontiguousarray(P, dtype=float)
+        H = np.zeros_like(P) if H is None else np.ascontiguousarray(H, dtype=float)
+        out = [np.empty_like(P) for _ in range(5)]
+        P2, H2 = P.reshape(1, -1) if P.ndim != 2 else P, H.reshape(1, -1) if H.ndim != 2 else H
+        coefficients(P2, H2, lam, self.kernel_params(), *(o.reshape(P2.shape) for o in out))
+        return tuple(out)
+
     def ln_eta(self, P: np.ndarray) -> np.ndarray:
         """ln(eta / eta0) at dimensionless pressure P, capped at :data:`ETA_LN_CAP`
-        (sub-ambient pressures use eta0)."""
-        p = np.maximum(P, 0.0) * self.p_hertz
-        lub = self.lubricant
-        if self.viscosity == "barus":
-            ln_eta = lub.alpha * p
-        else:
-            a = np.log(lub.eta0) - ROELANDS_LN_ETA_INF
-            ln_eta = a * ((1.0 + p / ROELANDS_P0_PA) ** lub.roelands_z - 1.0)
-        # beyond e^300 the Poiseuille term is zero to machine precision anyway; the cap keeps
-        # an intermediate pressure overshoot from turning into inf * 0 = nan
-        return np.minimum(ln_eta, ETA_LN_CAP)
+        (sub-ambient pressures use eta0): beyond e^300 the Poiseuille term is zero to machine
+        precision anyway; the cap keeps an intermediate pressure overshoot from turning into
+        inf * 0 = nan."""
+        return self._viscosity(P)[0]
 
     def eta(self, P: np.ndarray) -> np.ndarray:
         """eta / eta0 at dimensionless pressure P (sub-ambient pressures use eta0)."""
@@ -110,30 +128,94 @@ class PressureLaws:
     def dln_eta_dP(self, P: np.ndarray) -> np.ndarray:
         """d ln(eta / eta0) / dP at dimensionless pressure P (0 below ambient and beyond the
         cap :data:`ETA_LN_CAP`)."""
-        p = np.maximum(P, 0.0) * self.p_hertz
+        return self._viscosity(P)[1]
+
+    def max_dln_eta_dP(self, P_max: float) -> float:
+        """The largest d ln(eta / eta0) / dP over 0 <= P <= ``P_max``: alpha pH for Barus and
+        for Roelands with z <= 1 (its slope falls with pressure from alpha at ambient), else
+        the largest on 1024 steps (monotone up to the cap; 1 % margin)."""
         lub = self.lubricant
-        if self.viscosity == "barus":
-            slope = np.full_like(p, lub.alpha * self.p_hertz)
-        else:
-            a = np.log(lub.eta0) - ROELANDS_LN_ETA_INF
-            z = lub.roelands_z
-            slope = a * z * (1.0 + p / ROELANDS_P0_PA) ** (z - 1.0) * self.p_hertz / ROELANDS_P0_PA
-        return np.where((P > 0.0) & (self.ln_eta(P) < ETA_LN_CAP), slope, 0.0)
+        if self.viscosity == "barus" or lub.roelands_z <= 1.0:
+            return lub.alpha * self.p_hertz
+        return 1.01 * float(self.dln_eta_dP(np.linspace(0.0, max(P_max, 0.0), 1025)).max())
+
+    def _viscosity(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        P = np.ascontiguousarray(P, dtype=float)
+        ln_eta, dln = np.empty_like(P), np.empty_like(P)
+        viscosity(P.reshape(-1), self.kernel_params(), ln_eta.reshape(-1), dln.reshape(-1))
+        return ln_eta, dln
 
     def rho(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(rho / rho0, d(rho/rho0)/dP) at dimensionless pressure P."""
-        ph = self.p_hertz
-        p = np.maximum(P, 0.0) * ph
-        if self.density == "incompressible":
-            rho = np.ones_like(p)
-            drho = np.zeros_like(p)
-        else:
-            rho = (DH_A_PA + DH_B * p) / (DH_A_PA + p)
-            drho = ph * (DH_B - 1.0) * DH_A_PA / (DH_A_PA + p) ** 2
-        if self.twophase_p_scale is not None:
-            neg = P < 0.0
-            slope = ph / self.twophase_p_scale
-            if np.any(neg):
-                rho = np.where(neg, np.maximum(1.0 + P * slope, 0.0), rho)
-                drho = np.where(neg, slope, drho)
+        rho, drho, _, _, _ = self.evaluate(P)
         return rho, drho
+
+
+# --- numba kernels: the laws evaluated point by point, in one pass --------------------------
+@njit(cache=True, inline="always")
+def _viscosity_at(P, params):
+    """(ln(eta / eta0), d ln(eta / eta0) / dP) at one dimensionless pressure: Barus or
+    Roelands, eta0 below ambient, capped at :data:`ETA_LN_CAP` (slope 0 there)."""
+    ph = params[0]
+    p = max(P, 0.0) * ph
+    if params[1] == 0.0:
+        lne = params[2] * p
+        dln = params[2] * ph
+    else:
+        base = 1.0 + p / ROELANDS_P0_PA
+        pw = base ** params[4]
+        lne = params[3] * (pw - 1.0)
+        dln = params[3] * params[4] * pw / base * ph / ROELANDS_P0_PA
+    if lne >= ETA_LN_CAP:
+        return ETA_LN_CAP, 0.0
+    if P <= 0.0:
+        dln = 0.0
+    return lne, dln
+
+
+@njit(cache=True, inline="always")
+def ln_eta_at(P, params):
+    """ln(eta / eta0) at one dimensionless pressure."""
+    return _viscosity_at(P, params)[0]
+
+
+@njit(cache=True)
+def viscosity(P, params, ln_eta, dln):
+    """ln(eta / eta0) and its P-derivative at every point of the 1-D array P."""
+    for k in range(P.shape[0]):
+        ln_eta[k], dln[k] = _viscosity_at(P[k], params)
+
+
+def _coefficients(P, H, lam, params, rho, drho, eps, deps, ln_eta):
+    """Density, its P-derivative, the Poiseuille coefficient eps = rho max(H, 0)^3 /
+    (eta lambda), its viscosity derivative deps = -eps d ln(eta)/dP and ln(eta / eta0) at
+    every point, written into the output arrays (the laws of the :class:`PressureLaws` whose
+    :meth:`~PressureLaws.kernel_params` is ``params``)."""
+    ny, nx = P.shape
+    ph = params[0]
+    slope2 = params[6]
+    for j in prange(ny):
+        for i in range(nx):
+            Pv = P[j, i]
+            lne, dln = _viscosity_at(Pv, params)
+            if params[5] == 0.0:
+                r, dr = 1.0, 0.0
+            else:
+                p = max(Pv, 0.0) * ph
+                r = (DH_A_PA + DH_B * p) / (DH_A_PA + p)
+                dr = ph * (DH_B - 1.0) * DH_A_PA / ((DH_A_PA + p) * (DH_A_PA + p))
+            if slope2 != 0.0 and Pv < 0.0:
+                r = max(1.0 + Pv * slope2, 0.0)
+                dr = slope2
+            h = max(H[j, i], 0.0)
+            e = r * h * h * h / (np.exp(lne) * lam)
+            rho[j, i] = r
+            drho[j, i] = dr
+            eps[j, i] = e
+            deps[j, i] = -e * dln
+            ln_eta[j, i] = lne
+
+
+#: :func:`_coefficients` on one thread and on numba's threads (large grids)
+coefficients = njit(cache=True)(_coefficients)
+coefficients_parallel = njit(parallel=True, cache=True)(_coefficients)

@@ -10,8 +10,11 @@ zero-gradient outlet) and the film constant H0. Equations on every level:
 On the finest level f = 0, tauW = 0 and target = 2 pi / 3. The coarse levels carry the FAS
 right-hand sides (restricted residual plus coarse operator of the injected pressure), the
 FAS correction of the film (fine deformation minus coarse deformation of the injected
-pressure) and of the load. H0 is relaxed against the load on the coarsest level only.
-Full multigrid (FMG) start from a Hertzian pressure on the coarsest level.
+pressure) and of the load. H0 is relaxed against the load on the coarsest level, whose
+problem is solved (rounds of sweeps and H0 steps). Full multigrid (FMG) start from a
+Hertzian pressure on the coarsest level, each finer level cycled to its own discretisation
+error; the finest level until its film has settled (see :class:`SolverOptions`). Grid
+transfers: :mod:`ehlfoam.contact.transfer`.
 """
 
 from __future__ import annotations
@@ -24,8 +27,11 @@ import numpy as np
 from scipy.ndimage import minimum_filter
 
 from ehlfoam.contact.elastic import Deformation, hertz_pressure
-from ehlfoam.contact.lubricant import PressureLaws
-from ehlfoam.contact.reynolds import relax, residual
+from ehlfoam.contact.lubricant import PressureLaws, coefficients, coefficients_parallel
+from ehlfoam.contact.reynolds import relax, relax_parallel, residual, residual_parallel
+from ehlfoam.contact.threads import PARALLEL_MIN_POINTS, numba_threads, solve_threads
+from ehlfoam.contact.transfer import (prolong_bilinear, prolong_cubic, restrict_full_weighting,
+                                      restrict_pressure)
 
 LOAD_TARGET = 2.0 * math.pi / 3.0
 
@@ -49,8 +55,30 @@ class Domain:
 class SolverOptions:
     """Multigrid and convergence settings (dimensionless).
 
-    tol_residual: relative Reynolds residual sum|r| / sum|d(rho H)/dX| to reach.
+    nu1, nu2, gamma: sweeps before and after the coarse-grid correction; 2: W-cycles.
+    switch, w_gs, w_ja: Gauss-Seidel where eps / h^2 >= switch, distributive Jacobi
+        elsewhere; their under-relaxation factors.
+    w_ja_high_L, high_L, w_ja_high_M, high_M: the distributive-Jacobi factor above Moes
+        L = ``high_L`` (a sharp pressure spike: 0.5 stalls there, 0.2 does not) and above
+        M = ``high_M`` (0.5 lets hc swing by 1 % from cycle to cycle at M 34,000; 0.3 does
+        not); elsewhere 0.5 needs half the cycles of 0.2 (M 1000-4000).
+    zebra: the odd lines first, then the even ones (parallel; else in order).
+    coarsest_min_points: the coarsest grid has at most this many points a side.
+    coarse_sweeps, coarse_rounds, h0_gain: the coarsest level is solved by
+        ``coarse_rounds`` rounds of ``coarse_sweeps`` sweeps, each round followed by a step
+        H0 += gain (load - target) (a quarter of ``h0_gain`` above Moes M 1000): with the
+        coarse problem solved, the film constant is right after a cycle or two.
+    fmg_cycles, fmg_max_cycles, fmg_change: full-multigrid start, see
+        :meth:`MultigridSolver._fmg`.
     tol_load: relative load-balance error to reach.
+    film_fraction, film_rel_min, film_rel_max, tol_residual, film_max_residual: the solve
+        has converged once the load error is below ``tol_load``, a cycle changes the central
+        and the minimum film by less than :meth:`MultigridSolver.film_tolerance` and the
+        relative Reynolds residual sum|r| / sum|d(rho H)/dX| is below the larger of
+        ``tol_residual`` and ``film_max_residual``: the film, not the residual, is what the
+        precalc is for (at M above 10,000 a residual of 3e-5 still leaves hc 0.4 % off).
+    residual_only: a residual below which the solve has converged whatever the film does
+        (0: never; reference solves set it small).
     max_ln_eta_step: largest change of ln(eta / eta0) one relaxation sweep may make at a
         point (see :func:`limit_viscosity_step`); 0 switches the limiter off.
     limit_correction: hold the coarse-grid correction to the same viscosity-step limit as
@@ -58,19 +86,32 @@ class SolverOptions:
     stall_window, stall_ratio: the cycles stall when the best residual of the last
         ``stall_window`` cycles is not below ``stall_ratio`` times the best of the window
         before; the solve then goes on with :meth:`stalled` options (once).
+    workers: threads of the solve (scipy.fft and the numba kernels); None: the caller's
+        numba thread count (:func:`solve_threads`).
     """
 
     nu1: int = 2
-    nu2: int = 1
+    nu2: int = 2
     gamma: int = 2
     switch: float = 0.3
     w_gs: float = 0.4
-    w_ja: float = 0.2
+    w_ja: float = 0.5
+    w_ja_high_L: float = 0.2
+    high_L: float = 15.0
+    w_ja_high_M: float = 0.3
+    high_M: float = 5000.0
     coarsest_min_points: int = 33
-    coarse_sweeps: int = 10
-    coarse_rounds: int = 1
+    coarse_sweeps: int = 5
+    coarse_rounds: int = 10
     h0_gain: float = 0.05
     fmg_cycles: int = 2
+    fmg_max_cycles: int = 8
+    fmg_change: float = 0.2
+    film_fraction: float = 0.1
+    film_rel_min: float = 1e-4
+    film_rel_max: float = 1e-3
+    film_max_residual: float = 1e-3
+    residual_only: float = 0.0
     max_cycles: int = 100
     tol_residual: float = 3e-5
     tol_load: float = 3e-5
@@ -78,6 +119,8 @@ class SolverOptions:
     limit_correction: bool = False
     stall_window: int = 8
     stall_ratio: float = 0.7
+    workers: int | None = None
+    zebra: bool = True
 
     def stalled(self) -> "SolverOptions":
         """Options for the rest of a stalled solve (large L: a limit cycle between the pressure
@@ -97,17 +140,27 @@ class Problem:
     p_floor: float = 0.0
     neumann_outlet: bool = False
     moes_M: float = 100.0
+    moes_L: float = 0.0
+
+    @property
+    def params(self) -> np.ndarray:
+        """The pressure laws' parameter vector for the numba kernels."""
+        return self.laws.kernel_params()
 
 
 class Level:
     """One grid of the hierarchy with its FAS data."""
 
-    def __init__(self, nx: int, ny: int, x0: float, y0: float, h: float):
+    def __init__(self, nx: int, ny: int, x0: float, y0: float, h: float, workers: int = 1):
         self.nx, self.ny, self.h = nx, ny, h
         self.x = x0 + h * np.arange(nx)
         self.y = y0 + h * np.arange(ny)
         self.rigid = 0.5 * self.x[None, :] ** 2 + 0.5 * self.y[:, None] ** 2
-        self.deform = Deformation(nx, ny, h, h)
+        self.workers = workers if nx * ny >= PARALLEL_MIN_POINTS else 1
+        self.deform = Deformation(nx, ny, h, h, workers=self.workers)
+        self._coefficients = coefficients_parallel if self.workers > 1 else coefficients
+        self._residual = residual_parallel if self.workers > 1 else residual
+        self._relax = relax_parallel if self.workers > 1 else relax
         self.K0 = np.ascontiguousarray(self.deform.kernel[0, :6])
         self.K1 = np.ascontiguousarray(self.deform.kernel[1, :6])
         self.P = np.zeros((ny, nx))
@@ -115,51 +168,64 @@ class Level:
         self.tauW = np.zeros((ny, nx))
         self.load_target = LOAD_TARGET
         self.work = np.zeros((ny, nx))
+        self.sweeps = 0  # relaxation sweeps done on this level (work accounting)
+        self._coef = [np.empty((ny, nx)) for _ in range(5)]
+        self._W_of: np.ndarray | None = None  # the pressure whose deformation is self._W
+        self._W = np.zeros((ny, nx))
 
     def load(self, P: np.ndarray) -> float:
         return self.h * self.h * float(P.sum())
 
+    def deformation(self, P: np.ndarray) -> np.ndarray:
+        """W(P) by DC-FFT, remembered for the last pressure (a sweep, the residual and the
+        convergence check often ask for the same one)."""
+        if self._W_of is None or not np.array_equal(self._W_of, P):
+            self._W = self.deform(P)
+            self._W_of = P.copy()
+        return self._W
+
     def film(self, P: np.ndarray, H0: float) -> np.ndarray:
-        return H0 + self.rigid + self.deform(P) + self.tauW
+        return H0 + self.rigid + self.deformation(P) + self.tauW
 
     def coefficients(self, P: np.ndarray, H0: float, prob: Problem, H: np.ndarray | None = None):
-        """(H, rho, drho, eps) at pressure P; the film is computed unless given."""
+        """(H, rho, drho, eps, deps, ln_eta) at pressure P (arrays owned by the level, valid
+        until its next call); the film is computed unless given."""
         if H is None:
             H = self.film(P, H0)
-        rho, drho = prob.laws.rho(P)
-        eta = prob.laws.eta(P)
-        eps = rho * np.maximum(H, 0.0) ** 3 / (eta * prob.lam)
-        return H, rho, drho, eps
+        rho, drho, eps, deps, ln_eta = self._coef
+        self._coefficients(P, H, prob.lam, prob.params, rho, drho, eps, deps, ln_eta)
+        return H, rho, drho, eps, deps, ln_eta
 
     def residual(self, P: np.ndarray, H0: float, prob: Problem, f: np.ndarray | None = None,
                  raw: bool = False, H: np.ndarray | None = None):
         """(r, wedge, H) with r = f - L(P); unless ``raw``, r is zeroed where cavitation
         holds (P = 0, r > 0: the diverging gap would pull P below 0)."""
-        H, rho, _, eps = self.coefficients(P, H0, prob, H)
+        H, rho, _, eps, _, _ = self.coefficients(P, H0, prob, H)
         r = np.zeros_like(P)
         wedge = np.zeros_like(P)
-        residual(P, rho * H, eps, self.f if f is None else f, self.h, self.h, r, wedge)
+        self._residual(P, rho * H, eps, self.f if f is None else f, self.h, self.h, r, wedge)
         if not raw:
             r[(P <= prob.p_floor) & (r > 0.0)] = 0.0
         return r, wedge, H
 
     def relax(self, H0: float, prob: Problem, opt: SolverOptions) -> None:
-        H, rho, drho, eps = self.coefficients(self.P, H0, prob)
+        self.sweeps += 1
+        H, rho, drho, eps, deps, ln_eta = self.coefficients(self.P, H0, prob)
         P_old = self.P.copy() if opt.max_ln_eta_step > 0.0 else None
-        deps = -eps * prob.laws.dln_eta_dP(self.P)
-        relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
-              opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet, self.work,
-              deps)
+        self._relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
+                    opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet,
+                    self.work, deps, True, opt.zebra)
         if P_old is not None:
-            limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step)
+            limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step, ln_eta)
             if prob.neumann_outlet:
                 self.P[:, -1] = self.P[:, -2]
 
 
 def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
-                         max_step: float) -> None:
+                         max_step: float, ln_eta_old: np.ndarray | None = None) -> None:
     """Damp a relaxation sweep where it would change the viscosity by more than a factor
-    e^max_step; updates the dimensionless pressure ``P`` in place.
+    e^max_step; updates the dimensionless pressure ``P`` in place (``ln_eta_old``: the laws'
+    ln(eta / eta0) at ``P_old`` where known).
 
     The line systems hold eps = rho H^3 / (eta lambda) frozen, so where the pressure-viscosity
     product alpha pH is large (Moes L >= 20) a step of a few tenths in P changes eta by orders
@@ -168,41 +234,16 @@ def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
     fixed point (the limiter is inactive once the steps are small) and only slows the first
     sweeps of a large-L solve.
     """
-    dP = P - P_old
-    d_ln_eta = np.abs(laws.ln_eta(P) - laws.ln_eta(P_old))
+    dP_max = float(np.max(np.abs(P - P_old)))
+    if dP_max * laws.max_dln_eta_dP(max(float(P.max()), float(P_old.max()))) <= max_step:
+        return  # no point can have changed ln(eta) by more than max_step
+    if ln_eta_old is None:
+        ln_eta_old = laws.ln_eta(P_old)
+    d_ln_eta = np.abs(laws.ln_eta(P) - ln_eta_old)
     big = d_ln_eta > max_step
     if np.any(big):
-        P[big] = P_old[big] + dP[big] * (max_step / d_ln_eta[big])
-
-
-def _restrict_full_weighting(r: np.ndarray) -> np.ndarray:
-    rc = np.zeros(((r.shape[0] + 1) // 2, (r.shape[1] + 1) // 2))
-    rc[1:-1, 1:-1] = (
-        4.0 * r[2:-2:2, 2:-2:2]
-        + 2.0 * (r[2:-2:2, 1:-3:2] + r[2:-2:2, 3:-1:2] + r[1:-3:2, 2:-2:2] + r[3:-1:2, 2:-2:2])
-        + r[1:-3:2, 1:-3:2] + r[1:-3:2, 3:-1:2] + r[3:-1:2, 1:-3:2] + r[3:-1:2, 3:-1:2]
-    ) / 16.0
-    return rc
-
-
-def _restrict_pressure(P: np.ndarray, p_floor: float) -> np.ndarray:
-    """Coarse pressure: full weighting where the 3x3 fine neighbourhood is pressurised,
-    injection near the cavitation boundary and the domain boundary (keeps P >= 0 sharp)."""
-    Pc = P[::2, ::2].copy()
-    fw = _restrict_full_weighting(P)
-    allpos = minimum_filter(P > p_floor, size=3, mode="constant", cval=False)[::2, ::2]
-    allpos[[0, -1], :] = allpos[:, [0, -1]] = False
-    Pc[allpos] = fw[allpos]
-    return Pc
-
-
-def _prolong_bilinear(c: np.ndarray) -> np.ndarray:
-    ny, nx = 2 * c.shape[0] - 1, 2 * c.shape[1] - 1
-    f = np.zeros((ny, nx))
-    f[::2, ::2] = c
-    f[::2, 1::2] = 0.5 * (c[:, :-1] + c[:, 1:])
-    f[1::2, :] = 0.5 * (f[:-1:2, :] + f[2::2, :])
-    return f
+        dP = P[big] - P_old[big]
+        P[big] = P_old[big] + dP * (max_step / d_ln_eta[big])
 
 
 @dataclass
@@ -223,6 +264,10 @@ class MGResult:
     failure: str = ""
     #: cycle after which the stalled-solve options were used (None: never)
     stalled_at: int | None = None
+    #: central film of each FMG level below the finest (its discretisation-error estimate)
+    fmg_hc: list = field(default_factory=list)
+    #: relaxation sweeps of all levels in units of one finest-level sweep
+    work_units: float = 0.0
 
 
 class MultigridSolver:
@@ -238,7 +283,9 @@ class MultigridSolver:
                and (ny - 1) % 2 == 0):
             nx, ny, h = (nx - 1) // 2 + 1, (ny - 1) // 2 + 1, 2 * h
             sizes.append((nx, ny, h))
-        self.levels = [Level(n1, n2, dom.x_min, -dom.y_half, hh) for n1, n2, hh in reversed(sizes)]
+        self.workers = solve_threads(self.opt.workers)
+        self.levels = [Level(n1, n2, dom.x_min, -dom.y_half, hh, self.workers)
+                       for n1, n2, hh in reversed(sizes)]
         self.H0 = 0.0
         # the film constant reacts strongly to the load when heavily loaded: smaller steps
         self.h0_gain = self.opt.h0_gain * (0.25 if prob.moes_M > 1000.0 else 1.0)
@@ -273,18 +320,18 @@ class MultigridSolver:
         for _ in range(opt.nu1):
             lv.relax(self.H0, prob, opt)
         r, _, H = lv.residual(lv.P, self.H0, prob)
-        P_hat = _restrict_pressure(lv.P, prob.p_floor)
+        P_hat = restrict_pressure(lv.P, prob.p_floor)
         co.P = P_hat.copy()
         # film FAS correction: the coarse film of P_hat is the fine film at the coarse points
         H_hat = H[::2, ::2]
         co.tauW = H_hat - self.H0 - co.rigid - co.deform(P_hat)
         zero_f = np.zeros_like(P_hat)
         r_hat, _, _ = co.residual(P_hat, self.H0, prob, f=zero_f, raw=True, H=H_hat)  # -L_H(P_hat)
-        co.f = -r_hat + _restrict_full_weighting(r)
+        co.f = -r_hat + restrict_full_weighting(r)
         co.load_target = lv.load_target + co.load(P_hat) - lv.load(lv.P)
         for _ in range(opt.gamma if k > 1 else 1):
             self._cycle(k - 1)
-        corr = _prolong_bilinear(co.P - P_hat)
+        corr = prolong_bilinear(co.P - P_hat)
         # no correction inside the cavitated region, nor on its boundary
         corr[~minimum_filter(lv.P > prob.p_floor, size=3, mode="constant", cval=False)] = 0.0
         P_before = lv.P.copy() if opt.limit_correction else None
@@ -303,67 +350,142 @@ class MultigridSolver:
         res = [h[1] for h in history]
         return min(res[-w:]) > self.opt.stall_ratio * min(res[-2 * w:-w])
 
-    def measure(self) -> tuple[float, float, MGResult | None]:
-        lv = self.levels[-1]
+    def measure(self, k: int | None = None) -> tuple[float, float, np.ndarray]:
+        """(relative residual, relative load error, film) of level ``k`` (default: finest)."""
+        lv = self.levels[-1 if k is None else k]
         r, wedge, H = lv.residual(lv.P, self.H0, self.prob)
         denom = float(np.abs(wedge).sum()) or 1.0
         res = float(np.abs(r).sum()) / denom
         load_err = abs(lv.load(lv.P) - lv.load_target) / lv.load_target
         return res, load_err, H
 
+    def work_units(self) -> float:
+        """Relaxation sweeps done so far on all levels, in finest-level sweeps (each weighted
+        by its points)."""
+        top = self.levels[-1]
+        return sum(lv.sweeps * lv.nx * lv.ny for lv in self.levels) / (top.nx * top.ny)
+
+    def _centre(self, k: int) -> tuple[int, int]:
+        lv = self.levels[k]
+        return int(np.argmin(np.abs(lv.y))), int(np.argmin(np.abs(lv.x)))
+
     # --- driver ---------------------------------------------------------------------------
     def solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
-        """Solve from a Hertzian start by FMG, or from ``P_init`` (finest grid) by cycles."""
+        """Solve from a Hertzian start by FMG, or from ``P_init`` (finest grid) by cycles,
+        on :attr:`workers` threads."""
+        with numba_threads(self.workers):
+            return self._solve(H0_guess, P_init)
+
+    def _fmg(self) -> list[float]:
+        """Full multigrid start: the coarsest level from a Hertzian pressure, then each finer
+        level from the cubic interpolation of the coarser one, cycled until its central film
+        changes by less than ``fmg_change`` times the discretisation error that the two
+        levels estimate (|hc_k - hc_k-1| / 3, second order), at least ``fmg_cycles`` and at
+        most ``fmg_max_cycles`` cycles. The finest level is left interpolated (the caller
+        cycles it). Returns the central film of each level below the finest."""
+        opt = self.opt
+        self.fmg_counts = []
+        lv0 = self.levels[0]
+        X, Y = np.meshgrid(lv0.x, lv0.y)
+        lv0.P = hertz_pressure(X, Y)
+        self._enforce_bc(lv0)
+        self._solve_coarsest()
+        j, i = self._centre(0)
+        hc = [float(lv0.film(lv0.P, self.H0)[j, i])]
+        for k in range(1, len(self.levels)):
+            lv = self.levels[k]
+            lv.P = prolong_cubic(self.levels[k - 1].P)
+            lv.f[:] = 0.0
+            lv.tauW[:] = 0.0
+            lv.load_target = LOAD_TARGET
+            self._enforce_bc(lv)
+            if k == len(self.levels) - 1:
+                break
+            j, i = self._centre(k)
+            last = None
+            for n in range(opt.fmg_max_cycles):
+                self._cycle(k)
+                H = lv.film(lv.P, self.H0)
+                now = (float(H[j, i]), float(H.min()))
+                if (n + 1 >= opt.fmg_cycles and last is not None and np.all(np.isfinite(now))
+                        and max(abs(now[0] - last[0]), abs(now[1] - last[1]))
+                        < opt.fmg_change * abs(now[0] - hc[-1]) / 3.0):
+                    break
+                last = now
+            hc.append(now[0])
+            self.fmg_counts.append(n + 1)
+        return hc
+
+    def film_tolerance(self, hc: float, hc_coarse: float | None) -> float:
+        """Largest cycle-to-cycle change of the central and minimum film (units a^2/R) at
+        which the finest level counts as converged: ``film_fraction`` of its discretisation
+        error estimated from the FMG levels (|hc - hc_coarse| / 3), held between
+        ``film_rel_min`` and ``film_rel_max`` times hc (``film_rel_max`` without a coarse
+        estimate)."""
+        opt = self.opt
+        top = opt.film_rel_max * abs(hc)
+        if hc_coarse is None or not np.isfinite(hc_coarse):
+            return top
+        tol = opt.film_fraction * abs(hc - hc_coarse) / 3.0
+        return float(np.clip(tol, opt.film_rel_min * abs(hc), top))
+
+    def _solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
         t0 = time.perf_counter()
-        opt = base_opt = self.opt
+        base_opt = self.opt
+        if self.prob.moes_L > base_opt.high_L:
+            self.opt = replace(base_opt, w_ja=base_opt.w_ja_high_L)
+        elif self.prob.moes_M > base_opt.high_M:
+            self.opt = replace(base_opt, w_ja=base_opt.w_ja_high_M)
+        opt = self.opt
         self.H0 = H0_guess
         history = []
         if P_init is not None:
             self.levels[-1].P = P_init.copy()
             self._enforce_bc(self.levels[-1])
-            fmg_levels = []
+            fmg_hc = []
         else:
-            lv0 = self.levels[0]
-            X, Y = np.meshgrid(lv0.x, lv0.y)
-            lv0.P = hertz_pressure(X, Y)
-            self._enforce_bc(lv0)
-            self._solve_coarsest()
-            fmg_levels = range(1, len(self.levels))
-        # FMG: solve on each level, interpolate upwards
-        for k in fmg_levels:
-            self.levels[k].P = _prolong_bilinear(self.levels[k - 1].P)
-            self.levels[k].f[:] = 0.0
-            self.levels[k].tauW[:] = 0.0
-            self.levels[k].load_target = LOAD_TARGET
-            self._enforce_bc(self.levels[k])
-            for _ in range(opt.fmg_cycles):
-                self._cycle(k)
+            fmg_hc = self._fmg()
+        top = len(self.levels) - 1
         lv = self.levels[-1]
+        j, i = self._centre(top)
         converged = False
         failure = ""
         cycles = 0
         stalled_at = None
+        film_ok = 0
         res, load_err, H = self.measure()
-        history.append((0, res, load_err, self.H0, time.perf_counter() - t0))
-        while cycles < opt.max_cycles:
+        films = [(float(H[j, i]), float(H.min()))]
+        history.append((0, res, load_err, self.H0, time.perf_counter() - t0, *films[-1]))
+        while True:
             if not np.isfinite(res) or not np.all(np.isfinite(lv.P)):
                 failure = "non-finite pressure or residual"
                 break
-            if res < opt.tol_residual and load_err < opt.tol_load:
+            if load_err < opt.tol_load and (
+                    res < opt.residual_only
+                    or (film_ok and res < max(opt.tol_residual, opt.film_max_residual))):
                 converged = True
+                break
+            if cycles >= opt.max_cycles:
                 break
             if self._stalled(history):
                 self.opt = opt = opt.stalled()
                 stalled_at = cycles
-            self._cycle(len(self.levels) - 1)
+            self._cycle(top)
             cycles += 1
             res, load_err, H = self.measure()
-            history.append((cycles, res, load_err, self.H0, time.perf_counter() - t0))
+            films.append((float(H[j, i]), float(H.min())))
+            tol = self.film_tolerance(films[-1][0], fmg_hc[-1] if fmg_hc else None)
+            change = max(abs(films[-1][0] - films[-2][0]), abs(films[-1][1] - films[-2][1]))
+            film_ok = film_ok + 1 if change < tol else 0
+            history.append((cycles, res, load_err, self.H0, time.perf_counter() - t0,
+                            *films[-1]))
         self.opt = base_opt  # the stalled options hold for this solve only
         if not converged and not failure:
             failure = (f"not converged after {cycles} cycles: residual {res:.3g} "
-                       f"(tol {opt.tol_residual:g}), load error {load_err:.3g} (tol {opt.tol_load:g})")
+                       f"(tol {max(opt.tol_residual, opt.film_max_residual):g}), load error "
+                       f"{load_err:.3g} (tol {opt.tol_load:g}), film settled: {bool(film_ok)}")
         return MGResult(P=lv.P.copy(), H=H, H0=self.H0, x=lv.x.copy(), y=lv.y.copy(),
+                        work_units=self.work_units(),
                         converged=converged, residual=res, load_error=load_err, cycles=cycles,
                         history=history, wall_s=time.perf_counter() - t0, failure=failure,
-                        stalled_at=stalled_at)
+                        stalled_at=stalled_at, fmg_hc=fmg_hc)

@@ -15,8 +15,8 @@ from ehlfoam.contact.multigrid import Domain, MGResult, MultigridSolver, Problem
 from ehlfoam.contact.spec import P_AMBIENT_PA, PrecalcSpec
 from ehlfoam.contact.twophase import SubAmbientResult, solve_subambient
 
-#: Above this Moes M (or when a direct start fails) the solve starts from a solution at a
-#: lower M (speed ramp).
+#: When a direct (FMG) start fails, the solve starts again from a solution at a Moes M of
+#: at most this (speed ramp).
 CONTINUATION_M = 5000.0
 #: Multigrid cycles spent on each intermediate step of the speed ramp.
 RAMP_CYCLES = 4
@@ -37,6 +37,41 @@ def domain_for(spec: PrecalcSpec, M: float, n: int) -> Domain:
         return Domain(-2.5, 1.5, 2.0, n, n)
     # heavily loaded: the inlet zone is a fraction of a; spend the points near the contact
     return Domain(-1.8, 1.2, 1.5, n, n)
+
+
+@dataclass(frozen=True)
+class Start:
+    """A neighbouring solution to start a solve from (another speed, temperature or load):
+    its dimensionless pressure P (units pH) on axes x, y (units a), film constant H0
+    (units a^2/R) and Moes M, L."""
+
+    x: np.ndarray
+    y: np.ndarray
+    P: np.ndarray
+    H0: float
+    M: float
+    L: float
+
+    @classmethod
+    def from_result(cls, result: "PrecalcResult") -> "Start":
+        mg, c = result.mg, result.contact
+        return cls(mg.x, mg.y, mg.P, mg.H0, c.M, c.L)
+
+    def pressure_on(self, dom: Domain) -> np.ndarray:
+        """P interpolated (bilinear, in units of a) onto the grid of ``dom``; 0 outside."""
+        from scipy.interpolate import RegularGridInterpolator
+
+        x = np.linspace(dom.x_min, dom.x_max, dom.nx)
+        y = np.linspace(-dom.y_half, dom.y_half, dom.ny)
+        f = RegularGridInterpolator((self.y, self.x), self.P, bounds_error=False, fill_value=0.0)
+        Y, X = np.meshgrid(y, x, indexing="ij")
+        return f(np.stack([Y, X], axis=-1))
+
+
+def h0_guess(M: float, L: float) -> float:
+    """Film constant H0 (units a^2/R) of the NVM central film: Hc - 1 (the Hertzian
+    deformation at the centre is 1)."""
+    return moes_to_hertz_film(nijenbanning_moes_hc(M, max(L, 1e-9)), M) - 1.0
 
 
 @dataclass
@@ -147,12 +182,17 @@ def _ramp(solver, prob, opt, c, factor: float, start: float, h0_guess):
     return ramp, result
 
 
-def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcResult:
-    """Solve the EHL contact of ``spec``.
+def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
+          start: Start | None = None) -> PrecalcResult:
+    """Solve the EHL contact of ``spec``: full multigrid from a Hertzian start, then cycles
+    to convergence (:class:`~ehlfoam.contact.multigrid.MultigridSolver`); or, given a
+    neighbouring solution ``start`` (not for the two-phase option), cycles from its pressure
+    and its film constant shifted by the NVM films' difference, falling back to the full
+    multigrid start if that does not converge.
 
-    Above :data:`CONTINUATION_M` (or when a direct start fails) the solution is reached by a
-    speed ramp: M is stepped up by factors of at most 2 from a directly solvable M, each step
-    starting from the previous converged pressure and film constant.
+    Only when that direct start fails is the solution reached by a speed ramp: M is stepped
+    up by factors of at most 2 from M <= :data:`CONTINUATION_M` / 4, each step starting
+    from the previous pressure and film constant.
     """
     t0 = time.perf_counter()
     c = spec.contact()
@@ -164,31 +204,37 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None) -> PrecalcRes
     # two-phase: sub-ambient pressures allowed down to absolute zero (gauge -p_ambient)
     p_floor = -P_AMBIENT_PA / c.p_hertz if twophase else 0.0
     prob = Problem(lam=c.lam, laws=spec.laws(), p_floor=p_floor, neumann_outlet=twophase,
-                   moes_M=c.M)
+                   moes_M=c.M, moes_L=c.L)
     solver = MultigridSolver(prob, dom, opt)
 
-    def h0_guess(M: float) -> float:
-        return moes_to_hertz_film(nijenbanning_moes_hc(M, max(c.L, 1e-9)), M) - 1.0
+    def h0_at(M: float) -> float:
+        return h0_guess(M, c.L)
 
     if twophase:
         # the contact first, p >= 0 on the two-phase domain; then the sub-ambient field
         prob = replace(prob, p_floor=0.0, laws=replace(prob.laws, twophase_p_scale=None))
         solver.prob = prob
     ramp: list[float] = []
-    direct = result = None
-    if c.M <= CONTINUATION_M:
-        direct = result = solver.solve(h0_guess(c.M))
-    if result is None or not result.converged:
+    result = None
+    if start is not None and not twophase:
+        result = solver.solve(start.H0 + h0_guess(c.M, c.L) - h0_guess(start.M, start.L),
+                              P_init=start.pressure_on(dom))
+        if not result.converged:
+            solver = MultigridSolver(prob, dom, opt)
+            result = None
+    direct = result = result or solver.solve(h0_at(c.M))
+    if not result.converged:
         # a ramp by factors of 2 from M <= CONTINUATION_M / 4; if it blows up, a gentler one
         # (factors of sqrt 2 from M <= CONTINUATION_M / 8)
-        for factor, start in ((2.0, CONTINUATION_M / 4), (math.sqrt(2.0), CONTINUATION_M / 8)):
+        for factor, m_start in ((2.0, CONTINUATION_M / 4),
+                                (math.sqrt(2.0), CONTINUATION_M / 8)):
             solver = MultigridSolver(prob, dom, opt)  # fresh: no state of a failed attempt
-            ramp, attempt = _ramp(solver, prob, opt, c, factor, start, h0_guess)
-            if result is None or not _worse(attempt, result):
+            ramp, attempt = _ramp(solver, prob, opt, c, factor, m_start, h0_at)
+            if not _worse(attempt, result):
                 result = attempt
             if attempt.converged:
                 break
-        if direct is not None and _worse(result, direct):
+        if _worse(result, direct):
             result, ramp = direct, []  # the ramp did not help: keep the direct attempt
     subambient = None
     if twophase and np.all(np.isfinite(result.P)):

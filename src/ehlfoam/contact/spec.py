@@ -97,6 +97,21 @@ class PrecalcSpec(BaseModel):
                 f"must be 2**k + 1 with {GRID_MIN} <= grid <= {GRID_MAX} (e.g. 257, 513, 1025)")
         return v
 
+    @model_validator(mode="before")
+    @classmethod
+    def _temperature_in_table(cls, data):
+        """A tabulated oil's own temperature range, checked before the field's generic one
+        (so that --temperature 500 names HVI60's 25 to 60 C)."""
+        if not isinstance(data, dict):
+            return data
+        oil, temp = data.get("lubricant", "HVI60"), data.get("temperature")
+        if oil in OIL_TABLES and isinstance(temp, (int, float)) and not isinstance(temp, bool):
+            lo, hi = table_range(oil)
+            if not lo <= temp <= hi:
+                raise SpecError(f"temperature = {temp:g} C is outside the {oil} table: "
+                                f"valid range {lo:g} to {hi:g} C")
+        return data
+
     @model_validator(mode="after")
     def _lubricant_known(self) -> "PrecalcSpec":
         if self.lubricant == "custom":

@@ -207,6 +207,9 @@ def _status(metrics: dict | None, log: Path | None, case: Path | None = None
         return status, f"The run is still going ({live}); this report shows the last write."
     if status == "failed":
         return status, f"The run FAILED ({reason or 'unknown reason'})."
+    if status == "interrupted" and reason == "monitor_killed":
+        return status, ("The run was killed before it ended (monitor_killed: no process "
+                        "held its run lock); this report shows its last write.")
     if status == "interrupted":
         return status, "The run was interrupted (Ctrl-C or SIGTERM) before its end."
     return status, f"Run status: {status}."

@@ -169,7 +169,10 @@ def report_case(case_dir: str | os.PathLike, *, animate: bool = True,
 
 
 def _report_case(case_dir: str | os.PathLike, animate: bool, gif_frames: int) -> Path:
+    from ehlfoam.run.monitor import settle_killed_run
+
     start = time.perf_counter()
+    settle_killed_run(case_dir)   # a run killed with metrics.json 'running': say so in it
     info = load_case(case_dir)
     case = info.path
     out = case / REPORT

@@ -124,6 +124,22 @@ def crashed_record(case: Path, old: MetricsRecord | None = None) -> MetricsRecor
                               "its last write is kept")
 
 
+def settle_killed_run(case: str | os.PathLike) -> MetricsRecord | None:
+    """Rewrite a ``metrics.json`` that a killed run left saying ``running`` (its run lock is
+    free) as that run's end: :func:`crashed_record`. Returns the new record, or None when
+    there was nothing to settle (no record, another status, a run holding the lock, a folder
+    that cannot be written)."""
+    path = Path(case)
+    try:
+        with hold_run_lock(path) as lock:
+            crashed = crashed_record(path) if lock is not None else None
+            if crashed is not None:
+                write_metrics(path, crashed)
+            return crashed
+    except (CaseBusy, OSError):
+        return None
+
+
 def run_case(case: str | Path, runtime: FoamRuntime | None = None,
              wall_limit: float | None = None, on_sample: OnSample | None = None,
              extend_transits: float | None = None,
