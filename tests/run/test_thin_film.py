@@ -242,3 +242,12 @@ def test_a_killed_run_is_said_and_only_a_case_not_being_run_is_overwritten(ran, 
     assert (case / "state.npz").is_file()                          # left as it was
     assert main(["case", "--out", str(case), *SET, "--overwrite"]) == 0
     assert not (case / "state.npz").exists() and (case / "ehlfoam" / "case.json").is_file()
+
+
+def test_an_extension_beyond_max_steps_is_refused_before_anything_is_written(ran, tmp_path,
+                                                                           capsys):
+    case = copy_of(ran, tmp_path, run=True)
+    before = (case / "metrics.json").read_text()
+    assert main(["run", str(case), "--extend", "1e6", "--quiet"]) == 2
+    assert "more than run.max_steps" in capsys.readouterr().err
+    assert (case / "metrics.json").read_text() == before

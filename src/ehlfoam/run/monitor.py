@@ -171,7 +171,9 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
     if not path.is_dir():
         raise FileNotFoundError(f"case folder {path} does not exist")
     if is_thin_film_case(path):   # the gap-averaged model, no solver (issue 74)
-        return _run_thin_film(path, wall_limit, on_sample, extend_transits, on_note)
+        return run_thin_film_case(path, wall_limit=wall_limit, on_sample=on_sample,
+                                  extend_transits=extend_transits, crashed=crashed_record,
+                                  on_note=on_note)
     run = _Case(path, load_spec_of(path), load_geometry(path),
                 case_fields.Structure.load(path))
     check_n_procs(run.spec.run.n_procs, oversubscribe=oversubscribe)
@@ -193,24 +195,6 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
                            on_sample=on_sample, check_steady=extend_transits is None,
                            lock=lock, on_note=on_note)
         return monitor.run()
-
-
-def _run_thin_film(path: Path, wall_limit: float | None, on_sample: OnSample | None,
-                   extend_transits: float | None,
-                   on_note: Callable[[str], None] | None) -> MetricsRecord:
-    """A thin-film case: the extension within run.max_steps, then the model's run under the
-    case's run lock (:func:`ehlfoam.run.thin_film.run_thin_film_case`), an earlier run that
-    was killed marked as such first (:func:`crashed_record`). One core: the scene refuses
-    run.n_procs."""
-    from ehlfoam.case.bounds import check_extension
-
-    if extend_transits is not None:
-        geom = load_geometry(path)
-        check_extension(load_spec_of(path), extend_transits, geom.transit_time,
-                        geom.max_delta_t)
-    return run_thin_film_case(path, wall_limit=wall_limit, on_sample=on_sample,
-                              extend_transits=extend_transits, crashed=crashed_record,
-                              on_note=on_note)
 
 
 def _extend_end_time(case: Path, geom: CaseGeometry, transits: float) -> None:

@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ehlfoam.case.bounds import check_extension
 from ehlfoam.case.geometry import META, CaseGeometry, load_geometry, load_spec_of
 from ehlfoam.case.ownership import hold_run_lock
 from ehlfoam.case.thin_film import START
@@ -71,11 +72,14 @@ def run_thin_film_case(case: str | Path, *, wall_limit: float | None = None,
     (:func:`ehlfoam.case.ownership.hold_run_lock`) is held throughout: another process
     running it raises :class:`~ehlfoam.case.ownership.CaseBusy`. ``crashed``: called with
     the case under the lock, the record of an earlier run that was killed (a ``running``
-    metrics.json), which ``on_note`` is told of. Returns the record written."""
+    metrics.json), which ``on_note`` is told of. An extension beyond ``run.max_steps`` is
+    refused first (:class:`~ehlfoam.errors.SpecError`). Returns the record written."""
     if extend_transits is not None and not extend_transits > 0:
         raise ValueError(f"extend_transits = {extend_transits!r} transits: it must be > 0")
     path = Path(case).absolute()
     spec, geom = load_spec_of(path), load_geometry(path)
+    if extend_transits is not None:   # within run.max_steps, before anything is written
+        check_extension(spec, extend_transits, geom.transit_time, geom.max_delta_t)
     with hold_run_lock(path):
         if crashed is not None and crashed(path) is not None and on_note:
             on_note(f"the earlier run of {path} was killed before it ended (metrics.json "
