@@ -99,7 +99,7 @@ def test_ids_params_and_si_specs():
     assert pc.params == {"contact.speed": 0.008, "contact.temperature": 40.0,
                          "contact.load": 20.0, "supply.mode": "layers",
                          "supply.disc_layer": 2e-6, "supply.ball_layer": 2e-6,
-                         "mesh.resolution": "coarse"}
+                         "mesh.resolution": "coarse", "scene": "interface"}
     assert pc.spec.speed == 0.008 and pc.spec.supply.mode == "layers"    # layers: mode layers
     assert pc.spec.supply.disc_layer == 2e-6
     assert pc.spec.name == pc.id and pc.ramp is None
@@ -156,7 +156,7 @@ def test_ramp_steps_up_then_down():
         (0.008, "down"), (0.005, "down"), (0.008, "up")]
 
 
-@pytest.mark.parametrize("name, n_cases", [("default", 5), ("regime", 34)])
+@pytest.mark.parametrize("name, n_cases", [("default", 23), ("regime", 34)])
 def test_shipped_batch_specs_expand(name, n_cases):
     batch, plan = load_plan(ROOT / "examples" / "batches" / f"{name}.toml")
     assert batch.name == name and len(plan) == n_cases
@@ -178,8 +178,10 @@ def test_shipped_batch_specs_keep_their_case_ids():
     """The case ids name the cases' folders: the batch spec's keys in SI give the ids the
     display-unit keys gave."""
     _, plan = load_plan(ROOT / "examples" / "batches" / "default.toml")
-    assert [pc.id for pc in plan] == [f"u{u}_s1.5um_T40_F20_coarse"
-                                      for u in ("05.0", "08.0", "12.0", "17.0", "25.0")]
+    ids = [pc.id for pc in plan]
+    assert ids[:2] == ["u05.0_s0.45um_T40_F20_tf-medium_transits_max150",
+                       "u05.0_s1um_T40_F20_tf-medium_transits_max150"]
+    assert ids[-2:] == [f"u{u}_s0.45um_T40_F20_coarse_transits_max3" for u in ("08.0", "17.0")]
     _, plan = load_plan(ROOT / "examples" / "batches" / "breakthrough_release_low.toml")
     assert [pc.id for pc in plan] == [f"rampR_up0{k}_u{u}_s8um_T40_F20_coarse"
                                       for k, u in enumerate(("05.0", "06.5", "08.0", "09.5"),
@@ -203,3 +205,25 @@ def test_tracked_specs_are_valid(path):
         assert expand(parse_batch_spec(data, str(path)))
     else:
         assert load_case_spec(path).name
+
+
+def test_a_batch_sweeps_the_rung_thin_film_beside_3d():
+    """One point on two rungs (the thin-film scene and a 3D level) in one batch: distinct ids,
+    the scene in the params, and the regime analysis keeps their lines apart."""
+    from ehlfoam.batch.regime import analyse
+
+    plan = _plan({"base": {"mesh": {"resolution": "medium"}},
+                  "sweep": [{"contact.speed": [0.008, 0.017], "scene": ["thin-film"]},
+                            {"contact.speed": [0.008, 0.017], "scene": ["interface"]}]})
+    ids = [pc.id for pc in plan]
+    assert ids == ["u08.0_flooded_T40_F20_tf-medium", "u17.0_flooded_T40_F20_tf-medium",
+                   "u08.0_flooded_T40_F20_medium", "u17.0_flooded_T40_F20_medium"], ids
+    assert [pc.params["scene"] for pc in plan] == ["thin-film"] * 2 + ["interface"] * 2
+    rows = [{**pc.params, "case_id": pc.id, "status": "finished",
+             "state": "I" if pc.params["scene"] == "interface" or k == 0 else "II"}
+            for k, pc in enumerate(plan)]
+    lines = analyse(rows)["lines"]
+    assert sorted(ln["rung"] for ln in lines) == ["medium", "thin-film medium"]
+    by = {ln["rung"]: ln for ln in lines}
+    assert by["thin-film medium"]["transition_m_s"] is not None
+    assert by["medium"]["transition_m_s"] is None

@@ -29,8 +29,9 @@ __all__ = ["PARAM_KEYS", "PlannedCase", "case_count", "case_id", "est_cpu_s", "e
 
 #: The parameters every planned case carries (plan.json, results.csv), in order: the case
 #: spec's keys that name a case (SI; a layer is None unless the supply mode is "layers").
+#: The scene and the resolution together are the case's rung of the model ladder.
 PARAM_KEYS = ("contact.speed", "contact.temperature", "contact.load", "supply.mode",
-              "supply.disc_layer", "supply.ball_layer", "mesh.resolution")
+              "supply.disc_layer", "supply.ball_layer", "mesh.resolution", "scene")
 #: supplies given by their mode alone (no layer thicknesses)
 WHOLE_GAP_SUPPLIES = ("flooded", "submerged")
 _LAYERS = ("supply.disc_layer", "supply.ball_layer")
@@ -107,14 +108,15 @@ def _id_value(value: Any) -> str:
 
 
 def case_id(spec: CaseSpec, extra_keys: tuple[str, ...] = ()) -> str:
-    """A readable id, e.g. ``u08.0_s2um_T40_F20_coarse``, with ``_<leaf><value>`` for each of
-    ``extra_keys`` (other swept keys)."""
+    """A readable id, e.g. ``u08.0_s2um_T40_F20_coarse`` (``..._tf-medium`` in the thin-film
+    scene), with ``_<leaf><value>`` for each of ``extra_keys`` (other swept keys)."""
     s = spec.supply
     supply = supply_label(s.mode, s.disc_layer, s.ball_layer)
     c = spec.contact
     text = (f"u{_fmt(rounded(c.speed * 1e3), 2, 1)}_"
             f"{supply if supply in WHOLE_GAP_SUPPLIES else f's{supply}'}_"
-            f"T{_fmt(c.temperature)}_F{_fmt(c.load)}_{spec.mesh.resolution}")
+            f"T{_fmt(c.temperature)}_F{_fmt(c.load)}_"
+            f"{'tf-' if spec.scene == 'thin-film' else ''}{spec.mesh.resolution}")
     return text + "".join(f"_{k.rsplit('.', 1)[-1]}{_id_value(value_of(spec, k))}"
                           for k in extra_keys)
 

@@ -31,14 +31,14 @@ from typing import Any
 from ehlfoam._io import atomic_write_json
 from ehlfoam.batch.plan import WHOLE_GAP_SUPPLIES, supply_label
 
-__all__ = ["REGIME", "STATES", "analyse", "hysteresis", "point_state", "row_supply",
+__all__ = ["REGIME", "STATES", "analyse", "hysteresis", "point_state", "row_rung", "row_supply",
            "supply_sort", "transition", "write_regime"]
 
 STATES = ("I", "II")
 REGIME = "regime"
 SPEED = "contact.speed"
 #: what groups the cases of a line (besides the supply), and names its entry in regime.json
-GROUP = ("contact.temperature", "contact.load", "mesh.resolution")
+GROUP = ("contact.temperature", "contact.load", "rung")
 #: notes without numbers (the report words those with numbers from the fields)
 NO_CASE = "no finished case"
 INVERTED = "state II only below state I (no I -> II with increasing speed): no transition"
@@ -86,10 +86,17 @@ def _is_ramp(row: dict) -> bool:
     return row.get("ramp") not in (None, "")
 
 
+def row_rung(row: dict) -> str:
+    """The case's rung of the model ladder: its mesh level ("coarse"), or "thin-film medium"
+    for the thin-film scene (a row without a scene is a 3D case)."""
+    level = str(row.get("mesh.resolution"))
+    return f"thin-film {level}" if row.get("scene") == "thin-film" else level
+
+
 def _group(row: dict) -> dict[str, Any]:
     return {"contact.temperature": _float(row.get("contact.temperature")),
             "contact.load": _float(row.get("contact.load")), "supply": row_supply(row),
-            "mesh.resolution": str(row.get("mesh.resolution"))}
+            "mesh.resolution": str(row.get("mesh.resolution")), "rung": row_rung(row)}
 
 
 # ------------------------------------------------------------------ transitions
@@ -149,7 +156,7 @@ def _lines(rows: Iterable[dict]) -> list[dict[str, Any]]:
         groups[tuple(_group(r).values())].append(r)
     out = []
     for key, rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1],
-                                                          supply_sort(kv[0][2]), kv[0][3])):
+                                                          supply_sort(kv[0][2]), kv[0][4])):
         rs = sorted(rs, key=lambda r: _float(r[SPEED]))
         out.append({**_group(rs[0]), **_points(rs)})
     return out

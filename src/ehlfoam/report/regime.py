@@ -67,7 +67,7 @@ def _hysteresis_text(h: dict) -> str:
 
 def summary_lines(result: dict) -> list[str]:
     """One line per sweep line and per ramp of a regime analysis."""
-    lines = [f"{_conditions(ln)}, {ln['supply']}, {ln['mesh.resolution']}: "
+    lines = [f"{_conditions(ln)}, {ln['supply']}, {_rung(ln)}: "
              f"{transition_text(ln)}" for ln in result.get("lines", [])]
     for rp in result.get("ramps", []):
         text = (f"ramp {rp['name']} ({rp['supply']}, {_T.symbol} "
@@ -156,8 +156,17 @@ def _figure(panels: list[tuple[str, list]], ylabel: str, path: Path) -> None:
     _save(fig, path)
 
 
+def _rung(entry: dict) -> str:
+    """The entry's rung ("coarse", "thin-film medium"; older analyses: the mesh level)."""
+    return entry.get("rung") or entry["mesh.resolution"]
+
+
+def _rung_text(rung: str) -> str:
+    return rung if rung.startswith("thin-film") else f"{rung} mesh"
+
+
 def _key(entry: dict) -> tuple:
-    return entry["contact.temperature"], entry["contact.load"], entry["mesh.resolution"]
+    return entry["contact.temperature"], entry["contact.load"], _rung(entry)
 
 
 def _directed(branch: dict, direction: str) -> dict:
@@ -184,7 +193,7 @@ def _ramp_rows(result: dict, key: tuple) -> list[tuple[str, dict, bool]]:
 
 def _title(key: tuple) -> str:
     T, F, res = key
-    return f"{_T.symbol} = {T:g} {_T.unit}, {_F.symbol} = {F:g} {_F.unit}, {res} mesh"
+    return f"{_T.symbol} = {T:g} {_T.unit}, {_F.symbol} = {F:g} {_F.unit}, {_rung_text(res)}"
 
 
 def speed_supply_figure(result: dict, path: Path) -> bool:
@@ -206,15 +215,14 @@ def speed_supply_figure(result: dict, path: Path) -> bool:
 
 def speed_temperature_figure(result: dict, path: Path) -> bool:
     """State over (speed, temperature), one panel per supply/load/resolution."""
-    keys = sorted({(ln["supply"], ln["contact.load"], ln["mesh.resolution"])
-                   for ln in result["lines"]},
+    keys = sorted({(ln["supply"], ln["contact.load"], _rung(ln)) for ln in result["lines"]},
                   key=lambda k: (supply_sort(k[0]), k[1], k[2]))
     panels = []
     for supply, F, res in keys:
         lines = sorted((ln for ln in result["lines"]
-                        if (ln["supply"], ln["contact.load"], ln["mesh.resolution"])
-                        == (supply, F, res)), key=lambda ln: ln["contact.temperature"])
-        panels.append((f"supply {supply}, {_F.symbol} = {F:g} {_F.unit}, {res} mesh",
+                        if (ln["supply"], ln["contact.load"], _rung(ln)) == (supply, F, res)),
+                       key=lambda ln: ln["contact.temperature"])
+        panels.append((f"supply {supply}, {_F.symbol} = {F:g} {_F.unit}, {_rung_text(res)}",
                        [(f"{ln['contact.temperature']:g} {_T.unit}", ln, False)
                         for ln in lines]))
     if not panels:
