@@ -52,3 +52,21 @@ def test_every_parameter_has_its_display_in_the_one_table():
     assert units.scaled("contact.speed", 0.008) == pytest.approx(8.0)
     assert units.short_label("supply.disc_layer") == "disc layer [um]"
     assert units.short_label("oil_volume_m3") == "Oil volume (whole contact) [nl]"
+
+
+def test_the_first_screen_says_what_and_how_far(tmp_path):
+    """The batch report's summary: the spec's description, then a trust line per rung family
+    of the batch (thin-film first), none for a rung it does not hold."""
+    from ehlfoam.report.trust import TRUST, batch_description, trust_lines
+
+    (tmp_path / "batch.toml").write_text('name = "m"\ndescription = "A map, 40 C"\n')
+    assert batch_description(tmp_path) == "A map, 40 C"
+    assert batch_description(tmp_path / "nowhere") == ""
+    rows = [{"scene": "interface", "mesh.resolution": "coarse"},
+            {"scene": "thin-film", "mesh.resolution": "medium"},
+            {"mesh.resolution": "coarse"}]           # an older batch: no scene column
+    lines = trust_lines(rows)
+    assert len(lines) == 2
+    assert TRUST["thin-film"] in lines[0] and TRUST["coarse"] in lines[1]
+    assert trust_lines([{"scene": "interface", "mesh.resolution": "fine"}]) == [
+        f"How far to trust it: {TRUST['fine']}"]

@@ -38,6 +38,7 @@ from ehlfoam.report.charts import bubble_relation_x, draw_bubble_vs_speed, draw_
 from ehlfoam.report.html import Figure, Page, Table, cell, write_page
 from ehlfoam.report.regime import summary_lines, write_figures
 from ehlfoam.report.threads import single_blas_thread
+from ehlfoam.report.trust import batch_description, trust_lines
 from ehlfoam.report.top_view import bubble_length
 
 __all__ = ["after_batch", "bubble_points", "make_case_reports", "report_batch", "varying"]
@@ -276,6 +277,8 @@ def _report_batch(batch: Path, jobs: int | None, animate: bool, force: bool) -> 
                 status_text=f"{len(rows)} cases: " + ", ".join(
                     f"{n} {k}" for k, n in sorted(counts.items())) +
                 f". Finished cases in state I: {states['I']}, state II: {states['II']}.")
+    page.summary.extend([batch_description(batch), *trust_lines(rows)])   # what, how far
+    page.summary[:] = [line for line in page.summary if line]
     problems: list[str] = []
     try:
         _regime(batch, out, page)

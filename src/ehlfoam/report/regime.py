@@ -199,7 +199,8 @@ def _title(key: tuple) -> str:
 def speed_supply_figure(result: dict, path: Path) -> bool:
     """State over (speed, supply), one panel per temperature/load/resolution, ramp branches
     as rows of their own with arrows. False if there is nothing to draw."""
-    keys = sorted({_key(e) for e in result["lines"] + result["ramps"]}, key=str)
+    keys = sorted({_key(e) for e in result["lines"] + result["ramps"]},   # thin-film first
+                  key=lambda k: (not str(k[2]).startswith("thin-film"), str(k)))
     panels = []
     for key in keys:
         lines = sorted((ln for ln in result["lines"] if _key(ln) == key),

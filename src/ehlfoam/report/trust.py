@@ -1,0 +1,51 @@
+"""What a batch report's first screen says about its cases: the batch's own description and,
+for each rung of the model ladder it holds, one line on how far its numbers can be trusted,
+from the measurements in docs/validation.md (one place for those words)."""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Iterable
+from pathlib import Path
+
+from ehlfoam.batch.regime import row_rung
+
+__all__ = ["TRUST", "batch_description", "trust_lines"]
+
+#: One line per rung family: what its numbers are worth, measured at the nominal point
+#: (HVI60, 40 C, 20 N, 8 mm/s) against the converged 3D family (docs/validation.md).
+TRUST = {
+    "thin-film": (
+        "thin-film (gap-averaged, seconds a case): inlet meniscus 4.9 a against the converged "
+        "3D 5.6 a (12 % downstream), flooded width 15.4 a against 14.7 a (5 % wide); its "
+        "bubble is the gas-release scene's with an instant release (within 7 % of the 3D bath "
+        "at 99 kPa); a state within a speed step of the transition can flip with the grid or "
+        "the start (docs/models/thin-film.md)."),
+    "coarse": (
+        "3D coarse (minutes a case): a first look; the flooded width 17-21 % short of the "
+        "converged one, the inlet some 16 % upstream; three transits are not a rest "
+        "(docs/validation.md)."),
+    "medium": (
+        "3D medium: the default levels' width 17-21 % short of the converged one "
+        "(docs/validation.md)."),
+    "fine": (
+        "3D fine: the default levels' width 17-21 % short of the converged one; converged "
+        "values need the resolved family (docs/validation.md)."),
+}
+
+
+def batch_description(batch: Path) -> str:
+    """The ``description`` of the batch spec kept in the batch folder (batch.toml), or ""."""
+    try:
+        with open(batch / "batch.toml", "rb") as fh:
+            value = tomllib.load(fh).get("description", "")
+    except (OSError, tomllib.TOMLDecodeError):
+        return ""
+    return value if isinstance(value, str) else ""
+
+
+def trust_lines(rows: Iterable[dict]) -> list[str]:
+    """One line for each rung family among ``rows`` (results rows), thin-film first."""
+    families = {("thin-film" if rung.startswith("thin-film") else rung)
+                for rung in map(row_rung, rows)}
+    return [f"How far to trust it: {TRUST[f]}" for f in TRUST if f in families]
