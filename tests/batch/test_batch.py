@@ -147,7 +147,7 @@ def test_batch_layout_and_results(tiny):
     assert plan[0]["params"] == {"contact.speed": 0.01, "contact.temperature": 40.0,
                                  "contact.load": 20.0, "supply.mode": "layers",
                                  "supply.disc_layer": 3e-6, "supply.ball_layer": 3e-6,
-                                 "mesh.resolution": "coarse"}
+                                 "mesh.resolution": "coarse", "scene": "interface"}
     assert plan[0]["ramp"] is None
     assert plan[5]["ramp"] == {"name": "A", "step": 3, "direction": "down", "previous": RAMP[1]}
     with open(batch / "results.csv", newline="") as fh:

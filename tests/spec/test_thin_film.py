@@ -99,3 +99,17 @@ def test_the_3d_scenes_ignore_the_thin_film_table():
     spec = make_case_spec({"scene": "interface", "thin_film": {"cell": 0.05, "courant": 0.1},
                            "mesh": {"size_rim": 0.1}})
     assert spec.thin_film == ThinFilm(cell=0.05, courant=0.1)
+
+
+def test_the_thin_film_scene_looks_at_its_oil_twice_a_transit_unless_told():
+    from ehlfoam.spec.case import make_case_spec
+    from ehlfoam.spec.thin_film import THIN_FILM_WRITES_PER_TRANSIT
+
+    assert make_case_spec({"scene": "thin-film"}).run.writes_per_transit == \
+        THIN_FILM_WRITES_PER_TRANSIT == 2
+    assert make_case_spec({"scene": "thin-film", "run": {"transits_max": 50.0}}) \
+        .run.writes_per_transit == 2
+    assert make_case_spec({"scene": "thin-film", "run": {"writes_per_transit": 8}}) \
+        .run.writes_per_transit == 8
+    assert make_case_spec({}).run.writes_per_transit == 10          # the 3D scenes' default
+    assert make_case_spec(None, scene="thin-film").run.writes_per_transit == 2

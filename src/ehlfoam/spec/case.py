@@ -37,7 +37,7 @@ from ehlfoam.errors import SpecError, format_validation_error, models_in
 from ehlfoam.spec.levels import FOLLOW_POLAR_RADIUS, POLAR_RING_SHARE
 from ehlfoam.spec.mesh import Mesh
 from ehlfoam.spec.sections import STRICT, Domain, Physics, Run, Supply
-from ehlfoam.spec.thin_film import ThinFilm, check_thin_film
+from ehlfoam.spec.thin_film import THIN_FILM_WRITES_PER_TRANSIT, ThinFilm, check_thin_film
 
 #: The OpenFOAM application of each scene ("thin-film": none, the gap-averaged model of
 #: ehlfoam.thinfilm).
@@ -80,6 +80,18 @@ class CaseSpec(BaseModel):
     thin_film: ThinFilm = Field(ThinFilm(), description='The gap-averaged model of scene = '
                                                         '"thin-film": its grid and closures '
                                                         '(the 3D scenes ignore it).')
+
+    @model_validator(mode="before")
+    @classmethod
+    def _thin_film_defaults(cls, data: Any) -> Any:
+        """The thin-film scene looks at its oil less often unless told (run.writes_per_transit,
+        :data:`~ehlfoam.spec.thin_film.THIN_FILM_WRITES_PER_TRANSIT`)."""
+        if isinstance(data, dict) and data.get("scene") == "thin-film":
+            run = data.get("run", {})
+            if isinstance(run, dict) and "writes_per_transit" not in run:
+                data = {**data, "run": {**run,
+                                        "writes_per_transit": THIN_FILM_WRITES_PER_TRANSIT}}
+        return data
 
     @model_validator(mode="after")
     def _polar_ring_inside(self) -> "CaseSpec":

@@ -287,7 +287,8 @@ class Run(BaseModel):
                     "over one transit below which the run counts as steady.")
     writes_per_transit: int = Field(
         10, ge=2, le=1000,
-        description="Field writes per transit time (what the monitor sees).")
+        description="Field writes per transit time (what the monitor sees); unset, 2 in "
+                    "the thin-film scene.")
     wall_limit: float = Field(
         3600.0, gt=0.0, le=1e6,
         description="Wall-clock limit of the run.",
