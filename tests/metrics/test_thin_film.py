@@ -101,3 +101,21 @@ def test_the_raster_is_the_metrics_raster_mirrored_with_the_island_blank():
     both = ~r.island & ~r.island[::-1]
     np.testing.assert_allclose(r.alpha[::-1][both], r.alpha[both])       # mirrored
     assert r.dx == pytest.approx(A / 20)
+
+
+def test_the_raster_interpolation_is_scipys_bilinear():
+    """The separable weights give what scipy's RegularGridInterpolator (linear) gives, at
+    points between, on and beyond-clipped the source nodes."""
+    from scipy.interpolate import RegularGridInterpolator
+
+    from ehlfoam.metrics.thin_film import _linear_weights
+
+    rng = np.random.default_rng(3)
+    sy, sx = np.cumsum(rng.uniform(0.5, 1.5, 9)), np.cumsum(rng.uniform(0.5, 1.5, 13))
+    f = rng.uniform(size=(9, 13))
+    dy = np.clip(np.linspace(sy[0] - 1, sy[-1] + 1, 31), sy[0], sy[-1])
+    dx = np.clip(np.r_[np.linspace(sx[0], sx[-1], 40), sx], sx[0], sx[-1])
+    ours = _linear_weights(sy, dy) @ f @ _linear_weights(sx, dx).T
+    gy, gx = np.meshgrid(dy, dx, indexing="ij")
+    theirs = RegularGridInterpolator((sy, sx), f)(np.column_stack([gy.ravel(), gx.ravel()]))
+    assert np.allclose(ours, theirs.reshape(gy.shape), rtol=0, atol=1e-12)

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import ndimage
-from scipy.interpolate import RegularGridInterpolator
 
 from ehlfoam.metrics.pattern import bubble_mask, flow_pattern_from_raster
 from ehlfoam.metrics.raster import DEFAULT_CELL_OVER_A, Geometry, Raster, _grid
@@ -33,6 +32,18 @@ def _outside_island(values: np.ndarray, island: np.ndarray) -> np.ndarray:
     return values[tuple(nearest)]
 
 
+def _linear_weights(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
+    """The matrix W with W @ f = f linearly interpolated from ascending ``src`` to ``dst``
+    (``dst`` within [src[0], src[-1]])."""
+    k = np.clip(np.searchsorted(src, dst, side="right") - 1, 0, len(src) - 2)
+    t = (dst - src[k]) / (src[k + 1] - src[k])
+    w = np.zeros((len(dst), len(src)))
+    rows = np.arange(len(dst))
+    w[rows, k] = 1.0 - t
+    w[rows, k + 1] = t
+    return w
+
+
 def thin_film_raster(sol: ThinFilmSolution, geom: Geometry,
                      cell: float | None = None) -> Raster:
     """The state's mid-gap oil fraction on the metrics' raster of ``geom`` (a half domain,
@@ -41,11 +52,12 @@ def thin_film_raster(sol: ThinFilmSolution, geom: Geometry,
     grid = sol.grid
     alpha = _outside_island(np.nan_to_num(sol.mid_gap_alpha()), grid.island)
     y = np.concatenate([-grid.y[::-1], grid.y])
-    f = RegularGridInterpolator((y, grid.x), np.vstack([alpha[::-1], alpha]),
-                                method="linear")
     xs, ys = _grid(geom, float(cell if cell is not None else DEFAULT_CELL_OVER_A * geom.a))
-    gx, gy = np.meshgrid(np.clip(xs, grid.x[0], grid.x[-1]), np.clip(ys, y[0], y[-1]))
-    values = np.clip(f(np.column_stack([gy.ravel(), gx.ravel()])).reshape(gx.shape), 0, 1)
+    # bilinear on the regular grid, as two one-dimensional linear maps (a tenth of the cost
+    # of a point-by-point interpolator: the run reads its oil this way a few times a transit)
+    wy = _linear_weights(y, np.clip(ys, y[0], y[-1]))
+    wx = _linear_weights(grid.x, np.clip(xs, grid.x[0], grid.x[-1]))
+    values = np.clip(wy @ np.vstack([alpha[::-1], alpha]) @ wx.T, 0, 1)
     X, Y = np.meshgrid(xs, ys)
     island = X**2 + Y**2 <= geom.island_radius**2
     values[island] = np.nan
