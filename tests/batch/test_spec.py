@@ -230,3 +230,12 @@ def test_a_batch_sweeps_the_rung_thin_film_beside_3d():
     by = {ln["rung"]: ln for ln in lines}
     assert by["thin-film medium"]["transition_m_s"] is not None
     assert by["medium"]["transition_m_s"] is None
+
+
+def test_a_log_ranges_ids_keep_four_significant_digits():
+    plan = _plan({"sweep": {"contact.speed": {"start": 0.002, "stop": 0.1, "num": 12,
+                                              "spacing": "log"}}})
+    ids = [pc.id.split("_")[0] for pc in plan]
+    assert ids[:3] == ["u02.0", "u02.854", "u04.073"] and ids[-1] == "u100.0", ids
+    assert plan[1].params["contact.speed"] == pytest.approx(0.0028541829945)   # the value
+    assert len(set(ids)) == 12

@@ -80,10 +80,13 @@ def value_of(spec: CaseSpec, dotted: str) -> Any:
 
 def _fmt(v: float, width: int = 0, decimals: int = 0) -> str:
     """A number for an id: zero-padded integer part, at least ``decimals`` decimals, more if
-    needed to tell values apart (8.25 -> 08.25)."""
+    needed to tell values apart, up to four significant digits (8.25 -> 08.25; a log
+    range's 2.8541829945 -> 02.854)."""
     text = f"{v:.{decimals}f}"
     if float(text) != v:
-        text = f"{v:.10f}".rstrip("0")
+        magnitude = math.floor(math.log10(abs(v))) + 1 if v else 1
+        text = f"{v:.{max(decimals, 4 - magnitude, 0)}f}"
+        text = text.rstrip("0").rstrip(".") if "." in text else text
     if "." in text:
         whole, frac = text.split(".")
         return f"{whole.zfill(width)}.{frac}" if frac else whole.zfill(width)
