@@ -31,6 +31,10 @@ __all__ = ["CaseInfo", "find_log", "history_columns", "load_case", "load_geometr
 LOG_TAIL_LINES = 30
 #: A log written to within this many seconds counts as a live run [s].
 LIVE_LOG_S = 600.0
+#: What the report says of a run that was killed (metrics.json left running, or settled as
+#: interrupted with end_reason monitor_killed).
+KILLED = ("The run was killed before it ended (monitor_killed: no process held its run "
+          "lock); this report shows its last write.")
 #: metrics.json status values that mean the run is over and fine.
 FINISHED = "finished"
 
@@ -195,9 +199,7 @@ def _status(metrics: dict | None, log: Path | None, case: Path | None = None
             f"not steady (ended at {reason})"
         return status, f"The run finished: {steady}."
     if status == "running" and case is not None and not run_lock_held(case):
-        return "interrupted", ("The run was killed before it ended (monitor_killed: "
-                               "metrics.json says running, but no process holds its run "
-                               "lock); this report shows its last write.")
+        return "interrupted", KILLED
     if status == "running":
         live = (f"the solver log was written {age:.0f} s ago" if age is not None
                 else "no solver log yet")
@@ -208,8 +210,7 @@ def _status(metrics: dict | None, log: Path | None, case: Path | None = None
     if status == "failed":
         return status, f"The run FAILED ({reason or 'unknown reason'})."
     if status == "interrupted" and reason == "monitor_killed":
-        return status, ("The run was killed before it ended (monitor_killed: no process "
-                        "held its run lock); this report shows its last write.")
+        return status, KILLED
     if status == "interrupted":
         return status, "The run was interrupted (Ctrl-C or SIGTERM) before its end."
     return status, f"Run status: {status}."

@@ -4,11 +4,13 @@ from the measurements in docs/validation.md (one place for those words)."""
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Iterable
 from pathlib import Path
 
+from ehlfoam._io import read_toml
+from ehlfoam.batch.folder import SPEC_COPY
 from ehlfoam.batch.regime import row_rung
+from ehlfoam.errors import SpecError
 
 __all__ = ["TRUST", "batch_description", "trust_lines"]
 
@@ -37,9 +39,8 @@ TRUST = {
 def batch_description(batch: Path) -> str:
     """The ``description`` of the batch spec kept in the batch folder (batch.toml), or ""."""
     try:
-        with open(batch / "batch.toml", "rb") as fh:
-            value = tomllib.load(fh).get("description", "")
-    except (OSError, tomllib.TOMLDecodeError):
+        value = read_toml(batch / SPEC_COPY).get("description", "")
+    except SpecError:
         return ""
     return value if isinstance(value, str) else ""
 

@@ -132,12 +132,18 @@ def settle_killed_run(case: str | os.PathLike) -> MetricsRecord | None:
     path = Path(case)
     try:
         with hold_run_lock(path) as lock:
-            crashed = crashed_record(path) if lock is not None else None
-            if crashed is not None:
-                write_metrics(path, crashed)
-            return crashed
+            return _settle_held(path) if lock is not None else None
     except (CaseBusy, OSError):
         return None
+
+
+def _settle_held(path: Path) -> MetricsRecord | None:
+    """With the run lock held: a 'running' metrics.json rewritten as the killed run's end
+    (:func:`crashed_record`); returns that record, or None."""
+    crashed = crashed_record(path)
+    if crashed is not None:
+        write_metrics(path, crashed)
+    return crashed
 
 
 def run_case(case: str | Path, runtime: FoamRuntime | None = None,
@@ -181,13 +187,10 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
         check_extension(run.spec, extend_transits, run.geom.transit_time,
                         run.geom.max_delta_t)
     with hold_run_lock(path) as lock:
-        crashed = crashed_record(path)
-        if crashed is not None:
-            write_metrics(path, crashed)
-            if on_note:
-                on_note(f"the earlier run of {path} was killed before it ended (metrics.json "
-                        f"said running, its run lock was free): marked interrupted "
-                        f"({MONITOR_KILLED}); this run goes on from its latest write")
+        if _settle_held(path) is not None and on_note:
+            on_note(f"the earlier run of {path} was killed before it ended (metrics.json "
+                    f"said running, its run lock was free): marked interrupted "
+                    f"({MONITOR_KILLED}); this run goes on from its latest write")
         if extend_transits is not None:
             _extend_end_time(path, run.geom, extend_transits)
         monitor = _Monitor(run, runtime=runtime or FoamRuntime.from_environment(),
