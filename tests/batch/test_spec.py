@@ -36,7 +36,7 @@ def _plan(data: dict):
      ["sweep[1]: contact.load = 0.0", "valid range 0 < contact.load"]),
     ({"ramp": [{"name": "A"}]}, ["ramp[0].contact.speed: missing: a ramp needs its speeds"]),
     ({"base": {"mesh": {"follow": {}}}, "sweep": {"contact.speed": [0.005]}},
-     ["case u05.0_flooded", "has mesh.follow but no state to start from", "only a ramp's"]),
+     ["case u05.0_flooded", "has mesh.follow but no state to start from", "or set run.start = \"thin-film\""]),
     ({"base": {"mesh": {"follow": {}}}, "ramp": [{"name": "A", "contact.speed": [0.005, 0.008]}]},
      ["case rampA_up01_u05.0", "has mesh.follow but no state to start from"]),
     ({"ramp": [{"name": "A", "contact.speed": []}]}, ["a ramp without speeds"]),
@@ -99,7 +99,7 @@ def test_ids_params_and_si_specs():
     assert pc.params == {"contact.speed": 0.008, "contact.temperature": 40.0,
                          "contact.load": 20.0, "supply.mode": "layers",
                          "supply.disc_layer": 2e-6, "supply.ball_layer": 2e-6,
-                         "mesh.resolution": "coarse", "scene": "interface"}
+                         "mesh.resolution": "coarse", "scene": "interface", "rung": "coarse"}
     assert pc.spec.speed == 0.008 and pc.spec.supply.mode == "layers"    # layers: mode layers
     assert pc.spec.supply.disc_layer == 2e-6
     assert pc.spec.name == pc.id and pc.ramp is None
@@ -226,9 +226,9 @@ def test_a_batch_sweeps_the_rung_thin_film_beside_3d():
              "state": "I" if pc.params["scene"] == "interface" or k == 0 else "II"}
             for k, pc in enumerate(plan)]
     lines = analyse(rows)["lines"]
-    assert sorted(ln["rung"] for ln in lines) == ["medium", "thin-film medium"]
+    assert sorted(ln["rung"] for ln in lines) == ["medium", "thin-film-medium"]
     by = {ln["rung"]: ln for ln in lines}
-    assert by["thin-film medium"]["transition_m_s"] is not None
+    assert by["thin-film-medium"]["transition_m_s"] is not None
     assert by["medium"]["transition_m_s"] is None
 
 

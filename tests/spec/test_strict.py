@@ -67,7 +67,7 @@ def test_a_table_override_merges_into_the_files_table():
 @pytest.mark.parametrize("key, words", [
     ("contact.speed.x", "contact.speed.x: contact.speed is a value, not a table"),
     ("mesh.refine.x", "mesh.refine is a value, not a table"),
-    ("contract.speed", "contract: unknown key (valid here: name, scene, contact"),
+    ("contract.speed", "contract: unknown key (valid here: name, rung, scene, contact"),
     ("contact..speed", "is not a dotted key"),
 ])
 def test_a_dotted_key_must_name_a_table_then_a_key(key, words):

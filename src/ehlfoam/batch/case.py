@@ -19,7 +19,8 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ehlfoam._io import atomic_write_text
-from ehlfoam.batch.folder import CASES, LOCKS, SPEC_COPY, case_status, file_lock, metrics_or_none
+from ehlfoam.batch.folder import (CASES, LOCKS, SPEC_COPY, STARTS, case_status, file_lock,
+                                  metrics_or_none)
 from ehlfoam.batch.plan import PlannedCase, load_plan
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 
@@ -117,6 +118,7 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
     from ehlfoam.run.monitor import CaseBusy, run_case
 
     from ehlfoam.seed.follow import following_spec
+    from ehlfoam.seed.ladder import keep_start, thin_film_start
     from ehlfoam.seed.start import seed_case
 
     pc = plan_index(batch_dir)[case_id]
@@ -146,6 +148,11 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
                                        f"finished ({case_status(source)})")
             elif pc.ramp and pc.ramp.get("start_from"):   # the first step: a case or state
                 source = pc.ramp["start_from"]
+            kept = source is None and pc.spec.run.start == "thin-film" \
+                and pc.spec.scene != "thin-film"
+            if kept:   # the thin-film balance of the point (ehlfoam.seed.ladder)
+                stage = "thin-film start"
+                source = thin_film_start(pc.spec, batch_dir / STARTS / case_id)
             stage = "build"   # with mesh.follow, along the source's meniscus
             _clear_failed_build(case)
             seeded: list[dict] = []
@@ -154,6 +161,8 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
                 nonlocal stage
                 stage = "ramp start"
                 seeded.append(seed_case(tmp, source))
+                if kept:
+                    keep_start(source, tmp)
 
             write_case(following_spec(pc.spec, source), case, overwrite=True,
                        prepare=None if source is None else start)
@@ -187,7 +196,7 @@ def _record_failure(case: Path, case_id: str, stage: str, err: Exception,
     atomic_write_text(case / "error.log", traceback.format_exc())
     old = metrics_or_none(case)
     keep = old if old is not None and old.status == "running" else None   # this attempt's
-    metrics = _failed(keep, end_reason=f"{stage.replace(' ', '_')}_error",
+    metrics = _failed(keep, end_reason=f"{stage.replace(' ', '_').replace('-', '_')}_error",
                       reason=f"{stage}: {oneline(err)}", case_id=case_id,
                       case_wall_s=time.monotonic() - t0)
     write_metrics(case, metrics)

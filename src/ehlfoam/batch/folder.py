@@ -11,6 +11,8 @@ Layout of a batch folder (``runs/NAME/`` for ``runs/NAME.toml``)::
                         (ehlfoam.batch.results)
     regime/             regime.json: the regime analysis (ehlfoam.batch.regime), SI
     report/             the batch report (ehlfoam.report), with the regime pictures
+    starts/<id>/        the thin-film balance a 3D case with run.start = "thin-film" starts
+                        from (ehlfoam.seed.ladder; reused when the batch resumes)
     locks/<id>.lock     held by the process that builds and runs the case
     batch.lock          held by the ``ehlfoam batch`` process
 """
@@ -26,8 +28,8 @@ from pathlib import Path
 from ehlfoam.case.ownership import lock_held
 from ehlfoam.metrics.record import MetricsRecord, read_metrics
 
-SPEC_COPY, PLAN, RESULTS, CASES, LOCKS = (
-    "batch.toml", "plan.json", "results.csv", "cases", "locks")
+SPEC_COPY, PLAN, RESULTS, CASES, LOCKS, STARTS = (
+    "batch.toml", "plan.json", "results.csv", "cases", "locks", "starts")
 BATCH_LOCK = "batch.lock"
 STATUSES = ("pending", "running", "finished", "failed", "interrupted")
 

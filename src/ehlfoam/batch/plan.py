@@ -23,15 +23,18 @@ from ehlfoam.case.bounds import check_work
 from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import CaseSpec, make_case_spec
 from ehlfoam.spec.thin_film import thin_film_cpu_s
+from ehlfoam.spec.ladder import rung_family
 
 __all__ = ["PARAM_KEYS", "PlannedCase", "case_count", "case_id", "est_cpu_s", "expand",
            "load_plan"]
 
 #: The parameters every planned case carries (plan.json, results.csv), in order: the case
 #: spec's keys that name a case (SI; a layer is None unless the supply mode is "layers").
-#: The scene and the resolution together are the case's rung of the model ladder.
+#: The rung of the model ladder names the family (scene) and level together.
 PARAM_KEYS = ("contact.speed", "contact.temperature", "contact.load", "supply.mode",
-              "supply.disc_layer", "supply.ball_layer", "mesh.resolution", "scene")
+              "supply.disc_layer", "supply.ball_layer", "mesh.resolution", "scene", "rung")
+#: How a case id ends for each family of rungs (the level follows)
+_RUNG_TAGS = {"thin-film": "tf-", "resolved": "res-", "3d": ""}
 #: supplies given by their mode alone (no layer thicknesses)
 WHOLE_GAP_SUPPLIES = ("flooded", "submerged")
 _LAYERS = ("supply.disc_layer", "supply.ball_layer")
@@ -111,15 +114,15 @@ def _id_value(value: Any) -> str:
 
 
 def case_id(spec: CaseSpec, extra_keys: tuple[str, ...] = ()) -> str:
-    """A readable id, e.g. ``u08.0_s2um_T40_F20_coarse`` (``..._tf-medium`` in the thin-film
-    scene), with ``_<leaf><value>`` for each of ``extra_keys`` (other swept keys)."""
+    """A readable id, e.g. ``u08.0_s2um_T40_F20_coarse`` (``..._tf-medium`` on a thin-film
+    rung, ``..._res-medium`` on a resolved one), with ``_<leaf><value>`` for each of ``extra_keys`` (other swept keys)."""
     s = spec.supply
     supply = supply_label(s.mode, s.disc_layer, s.ball_layer)
     c = spec.contact
     text = (f"u{_fmt(rounded(c.speed * 1e3), 2, 1)}_"
             f"{supply if supply in WHOLE_GAP_SUPPLIES else f's{supply}'}_"
             f"T{_fmt(c.temperature)}_F{_fmt(c.load)}_"
-            f"{'tf-' if spec.scene == 'thin-film' else ''}{spec.mesh.resolution}")
+            f"{_RUNG_TAGS[rung_family(spec.rung)]}{spec.mesh.resolution}")
     return text + "".join(f"_{k.rsplit('.', 1)[-1]}{_id_value(value_of(spec, k))}"
                           for k in extra_keys)
 
@@ -237,11 +240,12 @@ def expand(batch: BatchSpec, max_cases: int = DEFAULT_MAX_CASES) -> list[Planned
                 ramp["start_from"] = str(Path(r.start_from).absolute())
             previous = _add(plan, batch, {**r.fixed, "contact.speed": u}, ramp, extra)
     for pc in plan.values():
-        if pc.spec.mesh.follow is not None and not (
+        if pc.spec.mesh.follow is not None and pc.spec.run.start != "thin-film" and not (
                 pc.ramp and (pc.ramp.get("previous") or pc.ramp.get("start_from"))):
             raise SpecError(f"invalid batch spec: case {pc.id} has mesh.follow but no state to "
-                            f"start from, whose meniscus its mesh would follow: only a ramp's "
-                            f"steps have one (its start_from, or the step before)")
+                            f"start from, whose meniscus its mesh would follow: a ramp's steps "
+                            f"have one (its start_from, or the step before), or set run.start "
+                            f"= \"thin-film\" (its point's thin-film balance)")
     _check_work(plan)
     return list(plan.values())
 

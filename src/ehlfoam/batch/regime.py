@@ -87,10 +87,13 @@ def _is_ramp(row: dict) -> bool:
 
 
 def row_rung(row: dict) -> str:
-    """The case's rung of the model ladder: its mesh level ("coarse"), or "thin-film medium"
-    for the thin-film scene (a row without a scene is a 3D case)."""
+    """The case's rung of the model ladder (its ``rung``: "thin-film-medium", "coarse",
+    "resolved-medium"; a row of an older batch without one: its scene and mesh level, a row
+    without a scene a 3D case)."""
+    if row.get("rung"):
+        return str(row["rung"])
     level = str(row.get("mesh.resolution"))
-    return f"thin-film {level}" if row.get("scene") == "thin-film" else level
+    return f"thin-film-{level}" if row.get("scene") == "thin-film" else level
 
 
 def _group(row: dict) -> dict[str, Any]:

@@ -34,12 +34,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         examples=["ehlfoam case examples/cases/nominal.toml --out runs/nominal "
                   "--set mesh.resolution=coarse",
                   "ehlfoam case examples/cases/nominal.toml --out runs/u17 "
-                  "--set contact.speed=0.017 --start-from runs/nominal"])
+                  "--set contact.speed=0.017 --start-from runs/nominal",
+                  "ehlfoam case examples/cases/nominal.toml --out runs/nominal_tf "
+                  "--rung thin-film-medium"])
     p.add_argument("spec", nargs="?", help="case spec TOML (default: the reference case)")
     p.add_argument("--out", required=True,
                    help="case folder to write; its path may not hold whitespace, quotes, a "
                         "backslash or any of *?[]{}$;<>|&` (OpenFOAM cannot take them)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help=SET_HELP)
+    p.add_argument("--rung", default=None, metavar="RUNG",
+                   help="the rung of the model ladder (the spec's `rung`, docs/ladder.md): "
+                        "thin-film-LEVEL, LEVEL (3D) or resolved-LEVEL, LEVEL one of coarse, "
+                        "medium, fine")
     p.add_argument("--overwrite", action="store_true", help="replace an existing case")
     p.add_argument("--start-from", default=None, metavar="CASE|SNAPSHOT.npz|STATE.npz",
                    help="start from the final fields of another run case (a converged "
@@ -47,7 +53,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         "mesh, else interpolated; from a case snapshot (`ehlfoam "
                         "snapshot`); or from the oil of a thin-film state "
                         "(`ehlfoam thin-film` writes one). With mesh.follow the mesh follows its "
-                        "meniscus (needed then)")
+                        "meniscus (without it, the case starts from the thin-film balance of its "
+                        "point: run.start = \"thin-film\", the resolved rungs)")
     p.set_defaults(func=cmd_case)
     return p
 
@@ -99,13 +106,16 @@ def cmd_case(args: argparse.Namespace) -> int:
     from ehlfoam.case.bounds import check_work
 
     overrides = parse_overrides(args.set)
+    if args.rung is not None:
+        overrides["rung"] = args.rung
     spec = (load_case_spec(args.spec, **overrides) if args.spec
             else make_case_spec(None, **overrides))
     check_case_out(args.out, "--out")
     check_work(spec)   # mesh.max_cells, run.max_steps: before the precalc and the mesher
-    if spec.mesh.follow is not None and not args.start_from:
+    if spec.mesh.follow is not None and not args.start_from and spec.run.start != "thin-film":
         raise SpecError("mesh.follow needs --start-from (a run case, a case snapshot or a "
-                        "thin-film state): the mesh follows that state's meniscus")
+                        "thin-film state) or run.start = \"thin-film\": the mesh follows "
+                        "that state's meniscus")
     if args.start_from:
         from ehlfoam.seed.start import RampError, check_start
 

@@ -157,12 +157,16 @@ def _figure(panels: list[tuple[str, list]], ylabel: str, path: Path) -> None:
 
 
 def _rung(entry: dict) -> str:
-    """The entry's rung ("coarse", "thin-film medium"; older analyses: the mesh level)."""
+    """The entry's rung ("coarse", "thin-film-medium"; older analyses: the mesh level)."""
     return entry.get("rung") or entry["mesh.resolution"]
 
 
 def _rung_text(rung: str) -> str:
-    return rung if rung.startswith("thin-film") else f"{rung} mesh"
+    """"thin-film medium", "resolved medium", "coarse mesh"."""
+    if " " in rung:                          # an older analysis's "thin-film medium"
+        return rung
+    family, _, level = rung.rpartition("-")
+    return f"{family} {level}" if family else f"{rung} mesh"
 
 
 def _key(entry: dict) -> tuple:

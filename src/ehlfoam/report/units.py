@@ -83,6 +83,7 @@ SPEC: dict[str, Unit] = {k: Unit(*v) for k, v in {
     "domain.island_radius": ("Island radius", "a", 1.0),
     "mesh.resolution": ("Mesh level", "", None, "mesh"),
     "scene": ("Scene", "", None, "scene"),
+    "rung": ("Rung of the model ladder", "", None, "rung"),
     "mesh.size_rim": ("Cell size at the island rim", "a", 1.0),
     "mesh.size_far": ("Cell size far away", "a", 1.0),
     "run.end_time": ("End time", "ms", 1e3),

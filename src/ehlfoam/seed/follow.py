@@ -30,6 +30,7 @@ from ehlfoam.case.ownership import check_replaceable
 from ehlfoam.case.writer import write_case
 
 from ehlfoam.seed.band import meniscus_bands, meniscus_lines, side_bands
+from ehlfoam.seed.ladder import keep_start, thin_film_start
 from ehlfoam.seed.start import seed_case
 
 
@@ -80,7 +81,9 @@ def following_spec(spec: CaseSpec, source: str | Path | None,
 def write_started_case(spec: CaseSpec, out: str | Path, source: str | Path | None,
                        overwrite: bool = False) -> tuple[CaseGeometry, dict[str, Any] | None]:
     """Write ``spec``'s case in ``out`` and start it from ``source`` (None: the spec's own
-    start); with ``mesh.follow`` its mesh follows the source's meniscus
+    start: its supply and puddle, or with ``run.start = "thin-film"`` the thin-film balance
+    of its point, run first in a sibling scratch folder and kept in the case,
+    :mod:`ehlfoam.seed.ladder`); with ``mesh.follow`` its mesh follows the source's meniscus
     (:func:`following_spec`). Returns the case geometry and the seed's record (None without a
     source). Raises ValueError for ``mesh.follow`` without a source (the case writer's), and
     :class:`~ehlfoam.case.ownership.CaseExists` for an ``out`` that may not be written (before
@@ -88,10 +91,29 @@ def write_started_case(spec: CaseSpec, out: str | Path, source: str | Path | Non
     that fails leaves no case behind (and an earlier case it was to replace as it was)."""
     out = Path(out).absolute()
     check_replaceable(out, overwrite)
+    if source is None and spec.run.start == "thin-film" and spec.scene != "thin-film":
+        out.parent.mkdir(parents=True, exist_ok=True)
+        work = Path(tempfile.mkdtemp(prefix=f".{out.name}.thin-film-start-", dir=out.parent))
+        try:
+            return _write_started(spec, out, thin_film_start(spec, work / "case"), overwrite,
+                                  kept=True)
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
+    return _write_started(spec, out, source, overwrite)
+
+
+def _write_started(spec: CaseSpec, out: Path, source: str | Path | None, overwrite: bool,
+                   kept: bool = False) -> tuple[CaseGeometry, dict[str, Any] | None]:
     if spec.mesh.follow is not None and source is not None:
         out.parent.mkdir(parents=True, exist_ok=True)
         spec = following_spec(spec, source, scratch=out.parent)
     seeded: list[dict[str, Any]] = []
-    prepare = None if source is None else (lambda tmp: seeded.append(seed_case(tmp, source)))
-    geom = write_case(spec, out, overwrite=overwrite, prepare=prepare)
+
+    def prepare(tmp: Path) -> None:
+        seeded.append(seed_case(tmp, source))
+        if kept:
+            keep_start(Path(source), tmp)
+
+    geom = write_case(spec, out, overwrite=overwrite,
+                      prepare=None if source is None else prepare)
     return geom, (seeded[0] if seeded else None)

@@ -34,10 +34,12 @@ from pydantic import BaseModel, Field, ValidationError, model_validator
 from ehlfoam._io import read_toml
 from ehlfoam.contact.spec import PrecalcSpec
 from ehlfoam.errors import SpecError, format_validation_error, models_in
+from ehlfoam.spec.ladder import RUNGS, THIN_FILM_START, expand_rung
 from ehlfoam.spec.levels import FOLLOW_POLAR_RADIUS, POLAR_RING_SHARE
 from ehlfoam.spec.mesh import Mesh
 from ehlfoam.spec.sections import STRICT, Domain, Physics, Run, Supply
-from ehlfoam.spec.thin_film import THIN_FILM_WRITES_PER_TRANSIT, ThinFilm, check_thin_film
+from ehlfoam.spec.thin_film import (THIN_FILM_WRITES_PER_TRANSIT, THREE_D_ONLY, ThinFilm,
+                                     check_thin_film)
 
 #: The OpenFOAM application of each scene ("thin-film": none, the gap-averaged model of
 #: ehlfoam.thinfilm).
@@ -52,6 +54,17 @@ class CaseSpec(BaseModel):
 
     model_config = STRICT
     name: str = Field("case", description="Label of the case in reports.")
+    rung: Literal[RUNGS] | None = Field(  # type: ignore[valid-type]
+        None,
+        description='The rung of the model ladder (docs/ladder.md): "thin-film-coarse", '
+                    '"thin-film-medium", "thin-film-fine" (the gap-averaged model, scene = '
+                    '"thin-film"); "coarse", "medium", "fine" (the 3D scene on the default '
+                    'mesh levels); "resolved-coarse", "resolved-medium", "resolved-fine" (the '
+                    '3D family whose width and inlet meniscus converge: the mesh follows the '
+                    'meniscus, 1 um slip, the wall at the Cox-Voinov angle of the rolling '
+                    'speed, started from the thin-film balance). Sets mesh.resolution (which '
+                    'must agree) and fills the rest under the spec\'s own keys; none: the '
+                    'rung of the scene and level.')
     scene: Literal["interface", "single-phase", "cavitating", "gas-release",
                    "thin-film"] = Field(
         "interface",
@@ -83,9 +96,12 @@ class CaseSpec(BaseModel):
 
     @model_validator(mode="before")
     @classmethod
-    def _thin_film_defaults(cls, data: Any) -> Any:
-        """The thin-film scene looks at its oil less often unless told (run.writes_per_transit,
+    def _rung_and_defaults(cls, data: Any) -> Any:
+        """The rung's settings (:func:`~ehlfoam.spec.ladder.expand_rung`); the thin-film
+        scene looks at its oil less often unless told (run.writes_per_transit,
         :data:`~ehlfoam.spec.thin_film.THIN_FILM_WRITES_PER_TRANSIT`)."""
+        if isinstance(data, dict):
+            data = expand_rung(data)
         if isinstance(data, dict) and data.get("scene") == "thin-film":
             run = data.get("run", {})
             if isinstance(run, dict) and "writes_per_transit" not in run:
@@ -213,6 +229,8 @@ def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> Case
     _check_supply_fits(spec)
     check_thin_film(spec)
     _check_scene_options(spec)
+    if spec.run.start == "thin-film" and spec.scene != "thin-film":
+        thin_film_counterpart(spec)   # the start must exist: refused now, not after a build
     return spec
 
 
@@ -230,6 +248,33 @@ def _check_scene_options(spec: CaseSpec) -> None:
             f"\"gas-release\" and supply.mode = \"submerged\" (here {spec.scene!r}, "
             f"{spec.supply.mode!r}): the scene has one gas, and where outer air meets the oil "
             f"it would dissolve the air too (valid range otherwise: 0)")
+
+
+def thin_film_counterpart(spec: CaseSpec, level: str = THIN_FILM_START["resolution"],
+                          transits_max: float = THIN_FILM_START["transits_max"]) -> CaseSpec:
+    """The thin-film case of a 3D spec's operating point (``run.start = "thin-film"``): the
+    same contact, supply, oil, wetting, pressures, domain and ``[thin_film]`` table on the
+    model's ``level``, marched to its balance within ``transits_max`` transits and the
+    spec's ``run.wall_limit``; the keys only the 3D scenes read are left out, and on a
+    resolved rung the wall's contact angle (the model takes the static one). Raises
+    :class:`SpecError` where the model has no counterpart of the spec (a submerged supply,
+    a full domain, still walls, two tracks, a contact angle of 90 deg or more)."""
+    data = spec.to_toml_dict()
+    for table, (names, _) in THREE_D_ONLY.items():
+        for name in names:
+            if table != "supply":   # a supply the model cannot take is refused below
+                data[table].pop(name, None)
+    if spec.mesh.follow is not None or str(spec.rung).startswith("resolved-"):
+        data["physics"].pop("contact_angle", None)   # the wall's, at the slip's scale: the
+        # model's menisci hold the static angle (docs/ladder.md)
+    data.update(scene="thin-film", rung=f"thin-film-{level}", mesh={},
+                run={"transits_max": transits_max, "wall_limit": spec.run.wall_limit})
+    try:
+        return make_case_spec(data)
+    except SpecError as err:
+        raise SpecError(f'invalid case spec: run.start = "thin-film": the thin-film model has '
+                        f'no counterpart of this case ({str(err).removeprefix("invalid case spec: ")})'
+                        ) from None
 
 
 def _check_supply_fits(spec: CaseSpec) -> None:

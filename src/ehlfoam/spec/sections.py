@@ -326,6 +326,13 @@ class Run(BaseModel):
     n_procs: int = Field(
         1, ge=1, le=1024,
         description="MPI ranks (1: serial).")
+    start: Literal["spec", "thin-film"] = Field(
+        "spec",
+        description='What a 3D case starts from: "spec", the supply\'s layers and the '
+                    'initial puddle; "thin-film", the thin-film model\'s balance of the same '
+                    'point (its medium level, run first: seconds to a minute), which brings the '
+                    'case to rest in fewer transits (a thin-film case is that balance: it '
+                    'marches from its puddle either way). --start-from overrides it.')
     max_steps: int = Field(
         10_000_000, ge=1, le=10**12,
         description="The most time steps a case may take to its end time: a case whose end "

@@ -210,3 +210,4 @@ def thin_film_cpu_s(spec: CaseSpec) -> float:
     cell = thin_film_cell(spec)
     steps = (spec.end_time * spec.speed / (cell * spec.a)) / spec.thin_film.courant
     return 1.0 + 1e-6 * thin_film_cells(spec) * steps if math.isfinite(steps) else 1.0
+

@@ -27,6 +27,7 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import brentq
 
 from ehlfoam.spec.case import CaseSpec
+from ehlfoam.spec.ladder import cox_voinov
 
 __all__ = ["BridgeBalance", "angle_at_meniscus", "bridge_balance", "cox_voinov",
            "meniscus_for_angle", "x_at_gap"]
@@ -81,14 +82,6 @@ def angle_at_meniscus(spec: CaseSpec, balance: BridgeBalance, x_m: float) -> flo
         return sigma * (np.cos(t) + np.cos(t + beta)) / hm - dp
     lo, hi = 0.0, np.pi / 2 - beta
     return float(np.degrees(brentq(g, lo, hi))) if g(lo) * g(hi) < 0 else float("nan")
-
-
-def cox_voinov(theta_s_deg: float, ca: float, ratio: float) -> float:
-    """Cox-Voinov's apparent angle [deg], theta^3 = theta_s^3 + 9 Ca ln(L / lambda), for the
-    static angle theta_s [deg], the capillary number Ca of the contact line's speed and the
-    ratio L / lambda of the macroscopic length to the slip length."""
-    t3 = np.radians(theta_s_deg) ** 3 + 9.0 * ca * np.log(ratio)
-    return float(np.degrees(np.cbrt(max(t3, 0.0))))
 
 
 def x_at_gap(gap: Gap, h: float, x_lo: float, x_hi: float) -> float:
