@@ -19,8 +19,8 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ehlfoam._io import atomic_write_text
-from ehlfoam.batch.folder import (CASES, LOCKS, SPEC_COPY, STARTS, case_status, file_lock,
-                                  metrics_or_none)
+from ehlfoam.batch.folder import (CASES, LOCKS, RESULTS, SPEC_COPY, STARTS, case_status,
+                                  file_lock, metrics_or_none)
 from ehlfoam.batch.plan import PlannedCase, load_plan
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 
@@ -31,16 +31,24 @@ LOCK_WAIT_S = 180.0
 _PLAN_CACHE: dict[str, tuple[tuple, dict[str, PlannedCase]]] = {}
 
 
-def plan_index(batch_dir: Path) -> dict[str, PlannedCase]:
-    """The batch folder's plan (from its batch.toml), by case id; cached per process."""
+def plan_index(batch_dir: Path, case_id: str | None = None) -> dict[str, PlannedCase]:
+    """The batch folder's plan (from its batch.toml), by case id, with the 3D confirmations
+    of its finished thin-film map (:mod:`ehlfoam.batch.confirm`); cached per process until
+    batch.toml changes or ``case_id`` is not in it."""
+    from ehlfoam.batch.confirm import confirm_plan
+    from ehlfoam.batch.results import read_results
+
     path = Path(batch_dir) / SPEC_COPY
     st = path.stat()
     stamp = (st.st_mtime_ns, st.st_size)
     hit = _PLAN_CACHE.get(str(path))
-    if hit and hit[0] == stamp:
+    if hit and hit[0] == stamp and (case_id is None or case_id in hit[1]):
         return hit[1]
-    _, plan = load_plan(path)
+    batch, plan = load_plan(path)
     index = {pc.id: pc for pc in plan}
+    if batch.confirm is not None and (Path(batch_dir) / RESULTS).is_file():
+        rows = read_results(Path(batch_dir))
+        index.update((pc.id, pc) for pc in confirm_plan(batch, plan, rows, Path(batch_dir)))
     _PLAN_CACHE[str(path)] = (stamp, index)
     return index
 
@@ -68,7 +76,7 @@ def ensure_precalc(batch_dir: Path, case_id: str) -> dict:
     too (the case build then fails with the precalc's message)."""
     from ehlfoam.gap.source import precalc_dir
 
-    contact = plan_index(batch_dir)[case_id].spec.contact
+    contact = plan_index(batch_dir, case_id)[case_id].spec.contact
     t0 = time.monotonic()
     try:
         with _precalc_lock(contact):
@@ -121,7 +129,7 @@ def execute_case(batch_dir: Path, case_id: str, rerun_failed: bool = False) -> d
     from ehlfoam.seed.ladder import keep_start, thin_film_start
     from ehlfoam.seed.start import seed_case
 
-    pc = plan_index(batch_dir)[case_id]
+    pc = plan_index(batch_dir, case_id)[case_id]
     case = batch_dir / CASES / case_id
     with file_lock(batch_dir / LOCKS / f"{case_id}.lock", timeout=LOCK_WAIT_S) as got:
         if not got:

@@ -47,6 +47,7 @@ from typing import Any
 from ehlfoam._io import atomic_write_json, atomic_write_text
 
 from ehlfoam.batch.case import oneline, precalc_cached
+from ehlfoam.batch.confirm import PREFIX, check_confirm, confirm_plan
 from ehlfoam.batch.executors import (DaskExecutor, LocalExecutor, check_slurm, cpu_budget,
                                      slurm_cluster)
 from ehlfoam.batch.folder import (BATCH_LOCK, CASES, LOCKS, PLAN, RESULTS, SPEC_COPY, STATUSES, batch_folder, case_status, file_lock)
@@ -216,6 +217,7 @@ def run_batch(spec_path: str | Path, opts: BatchOptions | None = None) -> BatchO
     if opts.slurm is not None:
         opts = replace(opts, slurm=check_slurm(opts.slurm))
     batch, plan = load_plan(spec_path, max_cases=opts.max_cases)
+    check_confirm(batch, plan)
     check_cores(opts, plan)
     batch_dir = batch_folder(spec_path, opts.out).absolute()
     check_finished_specs(batch_dir, plan)
@@ -245,6 +247,19 @@ def _run_locked(batch: BatchSpec, plan: list[PlannedCase], batch_dir: Path,
                      f"({executor.describe()}) -> {batch_dir}")
         try:
             runner.run()
+            extra = confirm_plan(batch, plan, runner.write_results(), batch_dir)
+            if extra:   # the 3D confirmations of the thin-film map's transitions
+                outcome, kept = runner.outcome, runner.skipped
+                plan = plan + extra
+                atomic_write_json(batch_dir / PLAN, [pc.to_json() for pc in plan])
+                runner = BatchRunner(batch_dir, plan, executor, rerun_failed=opts.rerun_failed,
+                                     progress=progress)
+                runner.outcome.update(outcome)
+                runner.skipped = kept + [i for i in runner.skipped if i.startswith(PREFIX)]
+                progress.log(f"confirm: {len(extra)} cases either side of the thin-film "
+                             f"transitions on the {batch.confirm.rung} rung "
+                             f"({batch.confirm.scene}), from the thin-film states")
+                runner.run()
         except KeyboardInterrupt:
             interrupted = True
             runner.stop()
@@ -279,8 +294,12 @@ def dry_run(spec_path: str | Path, out: Path | None = None,
 
     spec_path = Path(spec_path)
     batch, plan = load_plan(spec_path, max_cases=max_cases)
+    check_confirm(batch, plan)
     batch_dir = batch_folder(spec_path, out)
     lines = [f"batch {batch.name}: {len(plan)} cases -> {batch_dir}"]
+    if batch.confirm is not None:
+        lines.append(f"  then two {batch.confirm.rung} {batch.confirm.scene} cases at each "
+                     f"thin-film transition (confirm_...), from the thin-film states")
     contacts = {spec_key(pc.spec.contact) for pc in plan}
     new = {spec_key(pc.spec.contact) for pc in plan if not precalc_cached(pc.spec.contact)}
     total = 0.0

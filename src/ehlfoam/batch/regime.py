@@ -31,8 +31,8 @@ from typing import Any
 from ehlfoam._io import atomic_write_json
 from ehlfoam.batch.plan import WHOLE_GAP_SUPPLIES, supply_label
 
-__all__ = ["REGIME", "STATES", "analyse", "hysteresis", "point_state", "row_rung", "row_supply",
-           "supply_sort", "transition", "write_regime"]
+__all__ = ["REGIME", "STATES", "analyse", "confirmations", "hysteresis", "point_state",
+           "row_rung", "row_supply", "supply_sort", "transition", "write_regime"]
 
 STATES = ("I", "II")
 REGIME = "regime"
@@ -214,10 +214,31 @@ def _ramps(rows: Iterable[dict]) -> list[dict[str, Any]]:
     return out
 
 
+def confirmations(rows: list[dict]) -> list[dict[str, Any]]:
+    """Each confirming case beside the thin-film case it confirms: the speed [m/s], the
+    thin-film case's group (temperature, load, its rung as ``rung``) and supply, the
+    confirming rung (``confirm_rung``), both states, and whether they agree (None while
+    either has no state)."""
+    by_id = {r["case_id"]: r for r in rows}
+    out = []
+    for r in rows:
+        tf = by_id.get(r.get("confirms") or "")
+        if tf is None:
+            continue
+        states = (tf.get("state"), r.get("state"))
+        agree = states[0] == states[1] if all(s in STATES for s in states) else None
+        out.append({"case_id": r["case_id"], "confirms": tf["case_id"],
+                    "contact.speed": float(r["contact.speed"]), **_group(tf),
+                    "confirm_rung": row_rung(r),
+                    "state": states[1], "thin_film_state": states[0], "agree": agree})
+    return out
+
+
 def analyse(rows: Iterable[dict]) -> dict[str, Any]:
-    """Transitions of every sweep line and every ramp (see the module doc)."""
+    """Transitions of every sweep line and every ramp (see the module doc), and the 3D
+    confirmations of thin-film points (:func:`confirmations`)."""
     rows = list(rows)
-    return {"lines": _lines(rows), "ramps": _ramps(rows)}
+    return {"lines": _lines(rows), "ramps": _ramps(rows), "confirmations": confirmations(rows)}
 
 
 def write_regime(batch_dir: str | Path, rows: Iterable[dict] | None = None) -> dict[str, Any]:

@@ -19,7 +19,8 @@ LOG = "log.interFoam"
 
 #: results.csv: these columns first (the case's parameters: the case spec's dotted keys in
 #: SI), then any other swept key, then every other scalar of the metrics record, by its key.
-FIXED_COLUMNS = ("case_id", *PARAM_KEYS, "ramp", "ramp_step", "ramp_direction", "status",
+FIXED_COLUMNS = ("case_id", *PARAM_KEYS, "ramp", "ramp_step", "ramp_direction", "confirms",
+                 "status",
                  "end_reason", "reason", "state", "wall_s", "cells", "case_dir", "log")
 
 
@@ -67,7 +68,7 @@ def result_row(batch_dir: Path, pc: PlannedCase, live: bool = False,
     log = solver_log(case)
     row = {"case_id": pc.id, **pc.params, "ramp": ramp.get("name"),
            "ramp_step": ramp.get("step"), "ramp_direction": ramp.get("direction"),
-           "status": status, "end_reason": end_reason,
+           "confirms": ramp.get("confirms"), "status": status, "end_reason": end_reason,
            "reason": reason, "state": m.get("state") if status == "finished" else None,
            "wall_s": m.get("wall_s"), "cells": m.get("cells"),
            "case_dir": f"{CASES}/{pc.id}",

@@ -54,7 +54,7 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, RootModel,
 from ehlfoam._io import read_toml
 from ehlfoam.errors import SpecError, format_validation_error
 
-__all__ = ["DEFAULT_MAX_CASES", "BatchSpec", "Ramp", "SpecError", "Sweep", "count_cases",
+__all__ = ["DEFAULT_MAX_CASES", "BatchSpec", "Confirm", "Ramp", "SpecError", "Sweep", "count_cases",
            "load_batch_spec", "parse_batch_spec"]
 
 #: unknown keys refused, frozen, strict types (no true or "25" for a number); the swept
@@ -371,6 +371,29 @@ class Ramp(BaseModel):
                 "down-up": down + up[1:]}[self.branches]
 
 
+class Confirm(BaseModel):
+    """3D confirmations of a thin-film map (ehlfoam.batch.confirm): the two points either
+    side of each thin-film line's transition run again on a 3D rung, each from the thin-film
+    case's state."""
+
+    model_config = _STRICT
+    rung: Literal["coarse", "medium", "fine", "resolved-coarse", "resolved-medium",
+                  "resolved-fine"] = Field(
+        "coarse", description="The 3D rung of the confirmations (docs/ladder.md)",
+        json_schema_extra={"unit": ""})
+    scene: Literal["interface", "gas-release", "cavitating"] = Field(
+        "gas-release", description="The 3D scene: gas-release is the thin-film outlet's "
+                                   "counterpart (gas below physics.cavitation_pressure); "
+                                   "interface has no gas, so no bubble to break through",
+        json_schema_extra={"unit": ""})
+    set: dict[str, Any] = Field(
+        {"run.transits_max": 3.0},
+        description="Case-spec keys (dotted) for the confirmations on top of the thin-film "
+                    "case's point (its grid and run limits are left behind)",
+        json_schema_extra={"unit": "the case spec's unit of each key",
+                           "key": "<case-spec key>"})
+
+
 class BatchSpec(BaseModel):
     """A batch: ``base`` case spec data, ``sweep`` products and ``ramp`` sequences."""
 
@@ -387,6 +410,9 @@ class BatchSpec(BaseModel):
                                json_schema_extra={"unit": "the case spec's units (SI)"})
     ramp: list[Ramp] = Field([], description="Speed ramps ([[ramp]] tables)",
                              json_schema_extra={"unit": "m/s"})
+    confirm: Confirm | None = Field(None, description="3D confirmations of the thin-film "
+                                                      "map's transitions ([confirm] table)",
+                                    json_schema_extra={"unit": ""})
 
     @model_validator(mode="before")
     @classmethod

@@ -76,6 +76,16 @@ def summary_lines(result: dict) -> list[str]:
         if rp.get("hysteresis"):
             text += f"; {_hysteresis_text(rp['hysteresis'])}"
         lines.append(text)
+    confs = result.get("confirmations", [])
+    for c in confs:
+        verdict = {True: "agrees", False: "disagrees", None: "no state yet"}[c["agree"]]
+        lines.append(f"3D confirmation ({_rung_text(c['confirm_rung'])}) of "
+                     f"{_rung_text(c['rung'])} at {_u(c[SPEED]):.4g} {_U.unit}, "
+                     f"{c['supply']}, {_conditions(c)}: state {c['state'] or '-'} against "
+                     f"{c['thin_film_state'] or '-'}, {verdict}")
+    if confs:
+        agree = sum(c["agree"] is True for c in confs)
+        lines.append(f"3D confirmations: {agree} of {len(confs)} agree with the thin-film state")
     return lines
 
 
@@ -105,6 +115,22 @@ def _plot_transition(ax, t: dict, y: float, seen: set) -> None:
                 color="k", markersize=14, capsize=4, label=label)
 
 
+_RINGS = {True: dict(color="tab:green", label="3D agrees"),
+          False: dict(color="tab:purple", label="3D disagrees")}
+
+
+def _plot_confirmations(ax, confs: list[dict], y: float, seen: set) -> None:
+    """A ring round each confirmed point: green where the 3D rung agrees on the state."""
+    for c in confs:
+        if c["agree"] is None:
+            continue
+        st = dict(_RINGS[c["agree"]])
+        label = st.pop("label")
+        ax.plot([_u(c[SPEED])], [y], linestyle="none", marker="o", markersize=15, mfc="none",
+                mew=2, label=None if label in seen else label, **st)
+        seen.add(label)
+
+
 def _arrows(ax, speeds, y) -> None:
     for u0, u1 in zip(speeds, speeds[1:]):
         ax.annotate("", xy=(_u(u1), y), xytext=(_u(u0), y),
@@ -112,14 +138,18 @@ def _arrows(ax, speeds, y) -> None:
                                     shrinkA=6, shrinkB=6))
 
 
-def _panel(ax, rows_y: list[tuple[str, dict, bool]], title: str) -> None:
-    """rows_y: (label, line or branch, is a ramp branch)."""
+def _panel(ax, rows_y: list[tuple[str, dict, bool]], title: str,
+           confs: list[dict] = ()) -> None:
+    """rows_y: (label, line or branch, is a ramp branch); ``confs``: the 3D confirmations
+    of the panel's lines (a ring on the line of their supply)."""
     seen: set = set()
     for y, (label, ln, ramp) in enumerate(rows_y):
         if ramp:
             _arrows(ax, ln[SPEED], y)
         _plot_points(ax, ln[SPEED], y, ln["states"], seen)
         _plot_transition(ax, ln, y, seen)
+        if not ramp:
+            _plot_confirmations(ax, [c for c in confs if c["supply"] == ln["supply"]], y, seen)
     ax.set_yticks(range(len(rows_y)), [r[0] for r in rows_y])
     ax.set_ylim(-0.6, len(rows_y) - 0.4)
     ax.set_xlabel(_AXIS)
@@ -145,13 +175,14 @@ def _pyplot():
     return plt
 
 
-def _figure(panels: list[tuple[str, list]], ylabel: str, path: Path) -> None:
+def _figure(panels: list[tuple], ylabel: str, path: Path) -> None:
+    """panels: (title, rows_y) or (title, rows_y, confirmations)."""
     plt = _pyplot()
     n = len(panels)
     height = max(2.5, 0.45 * max(len(p[1]) for p in panels) + 1.6)
     fig, axes = plt.subplots(n, 1, figsize=(8.5, height * n), squeeze=False)
-    for ax, (title, rows_y) in zip(axes[:, 0], panels):
-        _panel(ax, rows_y, title)
+    for ax, (title, rows_y, *confs) in zip(axes[:, 0], panels):
+        _panel(ax, rows_y, title, *confs)
         ax.set_ylabel(ylabel)
     _save(fig, path)
 
@@ -210,8 +241,9 @@ def speed_supply_figure(result: dict, path: Path) -> bool:
         lines = sorted((ln for ln in result["lines"] if _key(ln) == key),
                        key=lambda ln: supply_sort(ln["supply"]))
         rows_y = [(ln["supply"], ln, False) for ln in lines] + _ramp_rows(result, key)
+        confs = [c for c in result.get("confirmations", []) if _key(c) == key]
         if rows_y:
-            panels.append((_title(key), rows_y))
+            panels.append((_title(key), rows_y, confs))
     if not panels:
         return False
     _figure(panels, "oil supply (layer on disc and ball)", path)
