@@ -122,3 +122,22 @@ def test_strips_lay_films_near_landau_levich_and_hold_a_contact_line(tmp_path):
     assert line["static_angle_deg"] <= line["apparent_angle_deg"] < 90.0
     assert "films behind a receding meniscus" in stdout
     assert "advancing contact line on dry walls" in stdout
+
+
+def test_ladder_accuracy_measures_each_rung_against_the_finest_at_rest(tmp_path):
+    """Two points on the two cheapest thin-film levels: the finer one at rest is each
+    point's reference (its own errors zero), the coarser one's errors are its metrics'
+    distance from it, and the summary has a row per rung with its cost."""
+    stdout, rec = run_bench("ladder_accuracy", tmp_path)
+    rows = rec["rows"]
+    assert [(r["point"], r["rung"]) for r in rows] == [
+        (p, r) for p in rec["points"] for r in ("thin-film-coarse", "thin-film-medium")]
+    for r in rows:
+        assert r["steady"] and r["reference"] == "thin-film-medium" and r["cpu_s"] > 0
+        ref = next(x for x in rows if x["point"] == r["point"] and x["rung"] == r["reference"])
+        assert r["err_width"] == pytest.approx(abs(r["width"] - ref["width"]) / ref["width"])
+        assert r["state_ok"] == (r["state"] == ref["state"])
+    assert {r["state"] for r in rows} == {"I", "II"}            # 8 mm/s I, 17 mm/s II
+    assert [s["rung"] for s in rec["summary"]] == ["thin-film-coarse", "thin-film-medium"]
+    assert rec["summary"][1]["max_width"] == 0 and rec["summary"][1]["cpu_over_reference"] == 1
+    assert len(table_rows(stdout, "rung  points")) == 2
