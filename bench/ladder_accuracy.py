@@ -180,7 +180,7 @@ def main(argv: list[str] | None = None) -> int:
     with work_folder(args.work) as work:
         for point in points:
             for rung in rungs:
-                case = work / f"{point[0].replace(' ', '_')}_{rung}"
+                case = work / f"{point[0].replace(' ', '_').replace('/', '')}_{rung}"
                 rows.append(run_point(point, rung, base, args.cap_s, case))
                 r = rows[-1]
                 print(f"{r['point']} {rung}: {r['state']} {r['end_reason']} "

@@ -76,3 +76,35 @@ def test_a_confirm_table_without_thin_film_cases_or_with_a_bad_key_is_refused(tm
     with pytest.raises(SpecError, match="confirm: the 3D case of u04.0.*run.transits_max"):
         run_batch(spec, BatchOptions(out=tmp_path / "bad", quiet=True, report=False))
     assert not (tmp_path / "bad").exists()
+
+
+def test_the_confirmations_are_the_brackets_of_the_lines_confirm_only_names(tmp_path):
+    """From a finished map's rows alone (no run): two cases a line with a transition, none
+    for a line in one state, only the lines ``confirm.only`` names, each from its thin-film
+    case's folder."""
+    from ehlfoam.batch.confirm import confirm_plan
+    from ehlfoam.batch.plan import expand
+    from ehlfoam.batch.spec import parse_batch_spec
+    import tomllib
+
+    data = tomllib.loads(MAP.replace("disc_layer = 0.45e-6, ball_layer = 0.45e-6, ", "")
+                         + "supply = [{disc_layer = 0.45e-6, ball_layer = 0.45e-6}, "
+                           "{disc_layer = 1e-6, ball_layer = 1e-6}, "
+                           "{disc_layer = 2e-6, ball_layer = 2e-6}]\n" + CONFIRM)
+    batch = parse_batch_spec(data, "map")
+    plan = expand(batch)
+    states = {0.45e-6: "I I II II", 1e-6: "I I I II", 2e-6: "I I I I"}
+    speeds = [0.004, 0.008, 0.017, 0.03]
+    rows = [{**pc.params, "case_id": pc.id, "status": "finished",
+             "state": states[pc.params["supply.disc_layer"]].split()[
+                 speeds.index(pc.params["contact.speed"])]} for pc in plan]
+    got = confirm_plan(batch, plan, rows, tmp_path)
+    assert [(pc.params["supply.disc_layer"], pc.params["contact.speed"]) for pc in got] == [
+        (0.45e-6, 0.008), (0.45e-6, 0.017), (1e-6, 0.017), (1e-6, 0.03)]
+    for pc in got:
+        assert pc.id.startswith("confirm_") and pc.spec.rung == "coarse"
+        assert pc.ramp["start_from"] == str(tmp_path / "cases" / pc.ramp["confirms"])
+    only = parse_batch_spec({**data, "confirm": {**data["confirm"],
+                                                 "only": {"supply.disc_layer": 1e-6}}}, "map")
+    assert [pc.params["contact.speed"] for pc in confirm_plan(only, plan, rows, tmp_path)] == \
+        [0.017, 0.03]

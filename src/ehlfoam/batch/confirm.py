@@ -3,12 +3,12 @@
 When every case of the plan has run, the regime analysis finds each thin-film line's
 transition; the two points either side of it (its highest speed in state I, its lowest in
 state II above it) are run again on a 3D rung (``confirm.rung``, the scene
-``confirm.scene``, the overrides ``confirm.set``), each started from the thin-film case's own
-state. Their ids are ``confirm_`` and the 3D case's id; ``results.csv`` says which thin-film
-case each confirms (``confirms``), and the regime analysis whether the two rungs agree on
-the state (:func:`ehlfoam.batch.regime.confirmations`). The plan of the confirmations
-follows from the finished map alone, so a batch that resumes finds the same cases and
-keeps those that ran.
+``confirm.scene``, the overrides ``confirm.set``; the lines whose cases have the values of
+``confirm.only``), each started from the thin-film case's own state. Their ids are
+``confirm_`` and the 3D case's id; ``results.csv`` says which thin-film case each confirms
+(``confirms``), and the regime analysis whether the two rungs agree on the state
+(:func:`ehlfoam.batch.regime.confirmations`). The plan of the confirmations follows from the
+finished map alone, so a batch that resumes finds the same cases and keeps those that ran.
 """
 
 from __future__ import annotations
@@ -68,6 +68,8 @@ def confirm_plan(batch: BatchSpec, plan: list[PlannedCase], rows: list[dict],
             row = next(r for r in rows if row_rung(r) == line["rung"]
                        and row_supply(r) == line["supply"] and _same(r, line, u))
             tf = by_id[row["case_id"]]
+            if any(value_of(tf.spec, k) != v for k, v in batch.confirm.only.items()):
+                continue
             spec = _spec_of(batch, tf)
             cid = PREFIX + case_id(spec)
             ramp = {"start_from": str(batch_dir / CASES / tf.id), "confirms": tf.id}

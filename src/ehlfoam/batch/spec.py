@@ -392,6 +392,11 @@ class Confirm(BaseModel):
                     "case's point (its grid and run limits are left behind)",
         json_schema_extra={"unit": "the case spec's unit of each key",
                            "key": "<case-spec key>"})
+    only: dict[str, Any] = Field(
+        {}, description="Confirm only the lines whose thin-film cases have these case-spec "
+                        "values (dotted keys; default: every line)",
+        json_schema_extra={"unit": "the case spec's unit of each key",
+                           "key": "<case-spec key>"})
 
 
 class BatchSpec(BaseModel):
