@@ -164,7 +164,7 @@ def check_thin_film(spec: CaseSpec) -> None:
     p, tf, d = spec.physics, spec.thin_film, spec.domain
     if spec.supply.mode == "submerged":
         problems.append('supply.mode = "submerged" does not apply to scene = "thin-film" '
-                        '(valid: "layers" or "flooded"; the model has outer air)')
+                        '(valid: "layers", "flooded" or "rig"; the model has outer air)')
     if d.symmetry != "half":
         problems.append(f'domain.symmetry = "{d.symmetry}" does not apply to scene = '
                         '"thin-film" (the model is marched on the half domain: "half")')
