@@ -38,6 +38,7 @@ import numpy as np
 from ehlfoam._io import atomic_write_text
 from ehlfoam.case.geometry import CaseGeometry, load_geometry, load_spec_of
 from ehlfoam.case.ownership import hold_run_lock
+from ehlfoam.errors import SpecError
 from ehlfoam.gap.field import GapField
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run.fields import Sample
@@ -76,11 +77,18 @@ def run_cycle_case(case: str | Path, *, wall_limit: float | None = None,
                    on_sample: Callable[[Sample, CaseGeometry], None] | None = None,
                    on_pass: OnPass | None = None,
                    crashed: Callable[[Path], MetricsRecord | None] | None = None,
-                   on_note: Callable[[str], None] | None = None) -> MetricsRecord:
+                   on_note: Callable[[str], None] | None = None,
+                   extend_transits: float | None = None) -> MetricsRecord:
     """Run the cycle of the "rig" thin-film case in ``case`` (module docstring) under its
     run lock; ``on_sample`` gets each pass's last sample, ``on_pass`` its row of
     cycle.csv, ``crashed`` and ``on_note`` as :func:`ehlfoam.run.thin_film.
-    run_thin_film_case`'s. Returns the record written."""
+    run_thin_film_case`'s. ``extend_transits`` is refused (:class:`SpecError`): a cycle
+    goes on by its passes (raise ``cycle.passes_max`` and run it again). Returns the record
+    written."""
+    if extend_transits is not None:
+        raise SpecError(f"extend_transits = {extend_transits:g} does not apply to a cycle of "
+                        "passes (supply.mode = \"rig\"): raise cycle.passes_max and run it "
+                        "again, it goes on from its last pass")
     path = Path(case).absolute()
     spec, geom = load_spec_of(path), load_geometry(path)
     with hold_run_lock(path):
