@@ -158,9 +158,11 @@ class ThinFilmProblem:
             if layer.shape != (ny,):
                 raise ValueError(f"supply_layers ({name}) has shape {layer.shape}: must be "
                                  f"({ny},), a layer on each of the grid's rows")
-            if not (np.isfinite(layer).all() and (layer >= 0).all()):
-                raise ValueError(f"supply_layers ({name}) = {layer!r} is out of range: "
-                                 "must be finite and >= 0 m on every row")
+            bad = ~(np.isfinite(layer) & (layer >= 0))
+            if bad.any():
+                raise ValueError(f"supply_layers ({name}) = {float(layer[bad][0]):g} m on row "
+                                 f"{int(np.argmax(bad))} is out of range: must be finite "
+                                 "and >= 0 m on every row")
 
     def supply_rows(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The layers the walls bring in on the rows at ``y`` [m] (both walls together,

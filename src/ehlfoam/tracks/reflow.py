@@ -22,9 +22,10 @@ Backward Euler in time, Newton's method on each step with the exact banded Jacob
 the equation is stiff (a cell's levelling time 3 eta dy^4 / (sigma h^3) is microseconds to
 seconds). Every Newton update has a zero sum (the Jacobian's columns sum to one: each face's
 flux leaves one cell and enters the next), so the layer's volume is kept to round-off
-whatever the Newton iterations did. A step that would leave a cell below zero (a
-fourth-order equation has no maximum principle) is halved; what remains of an undershoot at
-the smallest step is taken from the positive cells in proportion (the volume kept).
+whatever the Newton iterations did. A step whose Newton iteration fails is halved. A cell
+that a step leaves below zero (a fourth-order equation has no maximum principle: at the foot
+of a layer on dry wall, some 1e-3 of the layer) is set to zero and its deficit taken from the
+positive cells in proportion, the volume kept; the largest such undershoot is reported.
 
 Known answers (tests/tracks/test_reflow.py): a small sinusoidal perturbation of wavenumber
 k on a layer h0 decays at sigma h0^3 k^4 / (3 eta); a small ridge on a layer spreads as the
@@ -55,7 +56,7 @@ def levelling_time(h0: float, length: float, sigma: float, eta: float) -> float:
 
 @dataclass(frozen=True)
 class ReflowResult:
-    """The layer after the reflow [m], the steps taken (halvings included), the largest
+    """The layer after the reflow [m], the steps taken (halved ones included), the largest
     undershoot below zero that was taken back [m] and the volume change relative to the
     start (round-off)."""
 
@@ -101,13 +102,13 @@ def reflow(h: np.ndarray, dy: float, duration: float, sigma: float, eta: float, 
             dt = duration - t
         new = ops.step(h, dt, newton_tol, max_newton)
         taken += 1
-        low = float(new.min()) if new is not None else -np.inf
-        if (new is None or low < -1e-6 * h.max()) and dt > duration * 1e-9:
+        if new is None and dt > duration * 1e-9:
             queue += [dt / 2, dt / 2]                  # halve it
             continue
         if new is None:
             raise RuntimeError(f"the reflow's Newton iteration did not converge at t = {t:g} "
                                f"s with a step of {dt:g} s")
+        low = float(new.min())
         if low < 0:                                    # take the undershoot back, volume kept
             worst = max(worst, -low)
             pos = np.clip(new, 0.0, None)

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ehlfoam._io import atomic_write
+from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.tracks.reflow import reflow
 
 __all__ = ["Rig", "Tracks", "outlet_layers"]
@@ -210,11 +211,19 @@ class Tracks:
                        passes=int(d["passes"]))
 
 
-def outlet_layers(content: np.ndarray, gap: np.ndarray, flooded: np.ndarray,
-                  disc_share: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
-    """The layers (disc, ball) [m] a thin-film state leaves behind, row by row: what the
-    walls carry out of its last column (its oil content c; the full gap where the region
-    reaches the outlet, its Couette part), ``disc_share`` of it on the disc. At the state's
-    balance u times their sum over the rows is the supply (half domain)."""
-    c = np.where(flooded[:, -1], np.nan_to_num(gap[:, -1]), content[:, -1])
+def outlet_layers(sol: ThinFilmSolution, disc_share: float = 0.5
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """The layers (disc, ball) [m] a thin-film state ``sol`` leaves behind, row by row: the
+    oil content of its last column, which the walls carry out at u, ``disc_share`` of it on
+    the disc. At the state's balance u times their sum over the rows is the supply (half
+    domain). Raises ValueError where the flooded region reaches the outlet: there the flux
+    out is the small difference of the Couette and Poiseuille fluxes, which a state's cell
+    gaps cannot give (a march's exact profile is
+    :attr:`~ehlfoam.thinfilm.march.Marcher.oil_out_rows`)."""
+    last = sol.flooded[:, -1]
+    if last.any():
+        raise ValueError(f"the flooded region reaches the outlet on {int(last.sum())} rows: "
+                         "the layers it leaves are read from a march (Marcher.oil_out_rows), "
+                         "not from its state (or move the outlet out: domain.downstream)")
+    c = np.clip(sol.content[:, -1], 0.0, None)
     return disc_share * c, (1.0 - disc_share) * c
