@@ -183,10 +183,16 @@ class Tracks:
         last row], ``disc_share`` of it on the disc; both then level for their
         revolutions, and the next arc comes round. A row with a net inflow through the
         outlet (below zero: round-off, or oil the region drew in there) takes it from the
-        other rows in proportion, the volume kept."""
+        other rows in proportion, the volume kept; ValueError if the contact drew in more
+        than it let out (a region at the domain's edge)."""
         laid = np.asarray(outlet_rows, float).copy()
         laid[-1] += side
-        if (laid < 0).any() and laid.sum() > 0:      # round-off, or oil drawn in there:
+        if not laid.sum() >= 0:
+            raise ValueError(f"the contact drew in {-laid.sum():.3g} m3 more through its "
+                             "outlet and side than it let out: its region reaches the "
+                             "domain's edge (widen the domain: domain.side, "
+                             "domain.downstream)")
+        if (laid < 0).any():                         # round-off, or oil drawn in there:
             pos = np.clip(laid, 0.0, None)           # from the other rows, volume kept
             laid = pos * (laid.sum() / pos.sum())
         layer = laid / (rig.arc_length * rig.row)
