@@ -157,11 +157,14 @@ def _row(took, oil, state="I"):
 
 
 def test_the_cycle_s_end_is_told_from_its_passes():
-    """Still supply and oil over the last K + 1 passes: periodic; a repeating pattern of
+    """Still supply, oil and state over the last K + 1 passes: periodic (not while the state
+    flips); a repeating pattern of
     period 2 or 3 seen three times: a limit cycle; a drift: go on."""
     steady = [_row(1.0 + 0.5 ** k, 2.0) for k in range(30)]
     assert cycle_end(steady, arcs=4, tol=1e-6, period_max=8) == ("periodic", 1)
     assert cycle_end(steady[:10], arcs=4, tol=1e-6, period_max=8) == (None, None)
+    flipping = steady[:-2] + [_row(1.0, 2.0, "II"), _row(1.0, 2.0, "I")]
+    assert cycle_end(flipping, arcs=4, tol=1e-6, period_max=8) == (None, None)
     two = [_row(1.0 + (k % 2), 2.0 + (k % 2), "I" if k % 2 else "II") for k in range(9)]
     assert cycle_end(two, arcs=1, tol=1e-6, period_max=8) == ("limit_cycle", 2)
     three = [_row(1.0 + (k % 3), 2.0) for k in range(9)]

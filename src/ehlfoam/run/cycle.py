@@ -9,7 +9,8 @@ pass, its supply the tracks' layers on its rows. The cycle ends:
 
 - ``periodic``: over the last max(K, 2) passes the supply the inlet took in and the oil in
   the contact's domain changed by less than ``cycle.tolerance`` (relative) from one pass to
-  the next, and the contact laid back what it took in within it;
+  the next, the state stayed the same, and the contact laid back what it took in within
+  it;
 - ``limit_cycle``: not so, but the passes' supply, oil and state repeat with a period of 2
   to ``cycle.period_max`` passes within the tolerance, twice over (3 periods seen);
 - ``passes_max`` (``cycle.passes_max``), ``wall_limit`` (``run.wall_limit``), ``diverged``
@@ -210,7 +211,8 @@ def cycle_end(rows: list[dict], arcs: int, tol: float, period_max: int
     scale_o = max(np.abs(oil[-need - 1:]).max(), 1e-300)
     steady = (np.abs(np.diff(took[-need - 1:])).max() <= tol * scale_t
               and np.abs(np.diff(oil[-need - 1:])).max() <= tol * scale_o
-              and abs(laid[-1] - took[-1]) <= tol * scale_t)
+              and abs(laid[-1] - took[-1]) <= tol * scale_t
+              and len(set(states[-need - 1:])) == 1)
     if steady:
         return "periodic", 1
     for p in range(2, period_max + 1):
