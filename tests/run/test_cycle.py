@@ -10,6 +10,10 @@ import csv
 import json
 import math
 import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -118,6 +122,39 @@ def test_a_stopped_cycle_goes_on_from_its_last_pass(built, tmp_path):
     assert [int(r["pass"]) for r in rows] == list(range(1, len(rows) + 1))
     assert again["oil_rig_initial_m3"] == pytest.approx(float(rows[0]["oil_rig_initial_m3"]),
                                                         rel=1e-15)
+    assert again["oil_rig_balance_error"] < 1e-12
+
+
+def test_sigterm_ends_the_cycle_interrupted_and_it_goes_on_in_step(built, tmp_path):
+    """SIGTERM mid-cycle: end reason interrupted, the passes made kept; the pass cut short is
+    not written, so run again the cycle goes on with the next pass and the rig's oil is
+    still the start's to round-off."""
+    case = _copy(built, tmp_path)
+    spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
+    spec["cycle"] |= {"tolerance": 1e-15, "passes_max": 400}     # it runs on
+    (case / "ehlfoam" / "spec.json").write_text(json.dumps(spec))
+    proc = subprocess.Popen([sys.executable, "-m", "ehlfoam", "run", str(case), "--quiet"],
+                            env={**os.environ, **NO_FOAM}, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while not (case / "cycle.csv").exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(0.3)
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=60) == 1
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    m = json.loads((case / "metrics.json").read_text())
+    assert (m["status"], m["end_reason"]) == ("interrupted", "interrupted")
+    made = len(_rows(case))
+    assert made >= 1 and m["cycle_passes"] == made
+    spec["cycle"]["passes_max"] = made + 2
+    (case / "ehlfoam" / "spec.json").write_text(json.dumps(spec))
+    again = run_case(case)
+    assert again["end_reason"] == "passes_max" and len(_rows(case)) == made + 2
     assert again["oil_rig_balance_error"] < 1e-12
 
 

@@ -19,7 +19,8 @@ pass, its supply the tracks' layers on its rows. The cycle ends:
 Every pass writes a row of ``DIR/cycle.csv`` (its supply, state, inlet meniscus, bubble,
 the oil in the flooded region, the contact's domain and on each track, the rig's oil and
 its balance), the contact's ``state.npz`` and the tracks' ``tracks.npz``: a cycle that is
-stopped goes on from its last pass when run again, nothing lost. ``metrics.json`` holds the
+stopped goes on from its last pass when run again, nothing lost (a pass cut short is made
+again: its state is not written, so the contact's and the tracks' oil stay in step). ``metrics.json`` holds the
 last pass's flow pattern (the thin-film run's keys) and the cycle's summary (``cycle_*``,
 ``oil_rig_*`` keys). Volumes are the whole contact's and the whole tracks' (twice the half
 width marched).
@@ -158,9 +159,8 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
             if time.monotonic() - t_wall > wall_limit:
                 reason = "wall_limit"
                 break
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:   # the last pass's state and tracks stay: it goes on from them
         reason = "interrupted"
-        save_state(m.solution(), path / STATE_FILE)
     finally:
         if handled:
             signal.signal(signal.SIGTERM, previous)
