@@ -237,3 +237,21 @@ def test_oil_volumes_set_the_mean_layers_over_the_tracks():
     width = 2 * RIG["supply"]["track_half_width"]
     assert disc == pytest.approx(1e-9 / (2 * np.pi * 1.3e-3 * width))
     assert ball == pytest.approx(2e-10 / (2 * np.pi * spec.contact.radius * width))
+
+
+def test_a_batch_over_rig_cases_keeps_the_rig_supply(tmp_path):
+    """A sweep of the tracks' layers over a "rig" base stays "rig" (a layer alone means
+    "layers" otherwise), its ids say so, and a case's CPU estimate counts its passes."""
+    from ehlfoam.batch.plan import est_cpu_s, load_plan
+    spec = tmp_path / "rig.toml"
+    spec.write_text('name = "rigmap"\n[base]\nscene = "thin-film"\n'
+                    'supply = { mode = "rig", track_radius = 0.039 }\n'
+                    'cycle = { passes_max = 20 }\n[[sweep]]\ncontact.speed = [0.008, 0.017]\n'
+                    'supply = [{disc_layer = 0.6e-6, ball_layer = 0.6e-6}]\n')
+    _, plan = load_plan(spec)
+    assert [p.spec.supply.mode for p in plan] == ["rig", "rig"]
+    assert [p.id for p in plan] == ["u08.0_s0.6um-rig_T40_F20_tf-medium",
+                                    "u17.0_s0.6um-rig_T40_F20_tf-medium"]
+    assert plan[0].params["supply.disc_layer"] == 0.6e-6
+    layers = make_case_spec(plan[0].spec.model_dump(), **{"supply.mode": "layers"})
+    assert est_cpu_s(plan[0].spec) > 10 * est_cpu_s(layers)

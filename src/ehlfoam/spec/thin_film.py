@@ -206,7 +206,13 @@ def check_thin_film(spec: CaseSpec) -> None:
 def thin_film_cpu_s(spec: CaseSpec) -> float:
     """A rough CPU cost [s] of a thin-film run to its time limit (for a batch's ordering and
     first ETA): some 1 us per cell and step (a sparse solve a step), at
-    1 / thin_film.courant steps per cell's transit at u, over the run's time limit."""
+    1 / thin_film.courant steps per cell's transit at u, over the run's time limit (a
+    cycle of passes, supply.mode = "rig": over cycle.passes_max passes)."""
     cell = thin_film_cell(spec)
     steps = (spec.end_time * spec.speed / (cell * spec.a)) / spec.thin_film.courant
+    if spec.supply.mode == "rig":   # a cycle: its passes, a K-th of a disc turn each
+        r = spec.supply.track_radius
+        arcs = max(1, round(r / spec.contact.radius))
+        steps = spec.cycle.passes_max * 2 * math.pi * r / (
+            arcs * spec.thin_film.courant * cell * spec.a)
     return 1.0 + 1e-6 * thin_film_cells(spec) * steps if math.isfinite(steps) else 1.0
