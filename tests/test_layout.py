@@ -34,6 +34,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("spec",),
     ("gap",),
     ("thinfilm",),
+    ("tracks",),
     ("mesh",),
     ("case",),
     ("metrics",),

@@ -43,7 +43,7 @@ def test_the_cell_is_the_levels_unless_given(level):
     ("physics.gas_release_rate", 0.01, "physics.gas_release_rate = 0.01 does not apply"),
     ("supply.initial_bubble", 1.0, "supply.initial_bubble = 1.0 does not apply"),
     ("supply.mode", "submerged", 'supply.mode = "submerged" does not apply to scene = '
-                                 '"thin-film" (valid: "layers" or "flooded"'),
+                                 '"thin-film" (valid: "layers", "flooded" or "rig"'),
     ("domain.symmetry", "full", 'domain.symmetry = "full" does not apply'),
     ("walls_moving", False, "walls_moving = false does not apply"),
     ("physics.contact_angle", 95.0, "physics.contact_angle = 95 deg is out of range for scene = "

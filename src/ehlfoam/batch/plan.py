@@ -29,8 +29,8 @@ __all__ = ["PARAM_KEYS", "PlannedCase", "case_count", "case_id", "est_cpu_s", "e
            "load_plan"]
 
 #: The parameters every planned case carries (plan.json, results.csv), in order: the case
-#: spec's keys that name a case (SI; a layer is None unless the supply mode is "layers").
-#: The rung of the model ladder names the family (scene) and level together.
+#: spec's keys that name a case (SI; a layer is None unless the supply mode is "layers" or
+#: "rig"). The rung of the model ladder names the family (scene) and level together.
 PARAM_KEYS = ("contact.speed", "contact.temperature", "contact.load", "supply.mode",
               "supply.disc_layer", "supply.ball_layer", "mesh.resolution", "scene", "rung")
 #: How a case id ends for each family of rungs (the level follows)
@@ -72,8 +72,8 @@ class PlannedCase:
 
 def value_of(spec: CaseSpec, dotted: str) -> Any:
     """The value of a dotted key in a case spec (None for a layer of a supply that is not
-    "layers")."""
-    if dotted in _LAYERS and spec.supply.mode != "layers":
+    "layers" or "rig")."""
+    if dotted in _LAYERS and spec.supply.mode not in ("layers", "rig"):
         return None
     node: Any = spec
     for part in dotted.split("."):
@@ -101,11 +101,12 @@ def _um(metres: float) -> str:
 
 
 def supply_label(mode: str, disc_layer: float | None, ball_layer: float | None) -> str:
-    """"2um", "1+2um" (disc+ball), "flooded" or "submerged"."""
+    """"2um", "1+2um" (disc+ball), "flooded" or "submerged"; "2um-rig" for the oil on the
+    rig (the tracks' mean layers at the start)."""
     if mode in WHOLE_GAP_SUPPLIES:
         return mode
     d, b = _um(disc_layer), _um(ball_layer)
-    return f"{d}um" if d == b else f"{d}+{b}um"
+    return (f"{d}um" if d == b else f"{d}+{b}um") + ("-rig" if mode == "rig" else "")
 
 
 def _id_value(value: Any) -> str:
@@ -115,7 +116,8 @@ def _id_value(value: Any) -> str:
 
 def case_id(spec: CaseSpec, extra_keys: tuple[str, ...] = ()) -> str:
     """A readable id, e.g. ``u08.0_s2um_T40_F20_coarse`` (``..._tf-medium`` on a thin-film
-    rung, ``..._res-medium`` on a resolved one), with ``_<leaf><value>`` for each of ``extra_keys`` (other swept keys)."""
+    rung, ``..._res-medium`` on a resolved one), with ``_<leaf><value>`` for each of
+    ``extra_keys`` (other swept keys)."""
     s = spec.supply
     supply = supply_label(s.mode, s.disc_layer, s.ball_layer)
     c = spec.contact
@@ -127,15 +129,19 @@ def case_id(spec: CaseSpec, extra_keys: tuple[str, ...] = ()) -> str:
                           for k in extra_keys)
 
 
-def _with_mode(values: dict[str, Any]) -> dict[str, Any]:
-    """Setting a layer without the supply mode means the layers mode."""
+def _with_mode(values: dict[str, Any], base: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Setting a layer without the supply mode means the layers mode, unless the base's
+    supply is the oil on the rig (its layers are the tracks' at the start)."""
+    supply = (base or {}).get("supply")
+    if isinstance(supply, dict) and supply.get("mode") == "rig":
+        return values
     if any(k in values for k in _LAYERS) and "supply.mode" not in values:
         return {"supply.mode": "layers", **values}
     return values
 
 
 def _case_spec(base: dict[str, Any], values: dict[str, Any]) -> CaseSpec:
-    return make_case_spec({**base, "name": "case"}, **_with_mode(values))
+    return make_case_spec({**base, "name": "case"}, **_with_mode(values, base))
 
 
 def _invalid(where: str, err: SpecError) -> SpecError:
@@ -181,9 +187,9 @@ def _swept_keys(batch: BatchSpec) -> tuple[str, ...]:
     for sw in batch.sweep:
         for key, values in sw.root.items():
             for value in values:
-                keys.update(dict.fromkeys(_with_mode(overrides(key, value))))
+                keys.update(dict.fromkeys(_with_mode(overrides(key, value), batch.base)))
     for r in batch.ramp:
-        keys.update(dict.fromkeys(_with_mode(r.fixed)))
+        keys.update(dict.fromkeys(_with_mode(r.fixed, batch.base)))
     return tuple(keys)
 
 

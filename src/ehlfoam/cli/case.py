@@ -151,11 +151,13 @@ def _write(spec, args: argparse.Namespace) -> int:
         if seed.get("oil"):
             print(oil_carried(seed["oil"]))
     if spec.scene == "thin-film":   # no OpenFOAM: the model's grid (issue 74)
+        until = (f"a cycle of at most {spec.cycle.passes_max} passes on a "
+                 f"{spec.supply.track_radius * 1e3:g} mm track" if spec.supply.mode == "rig"
+                 else f"end time {geom.end_time:.3g} s")
         print(f"case {args.out}: thin-film model, {geom.cells} cells of "
               f"{geom.min_cell_size / geom.a:g} a, a = {geom.a * 1e3:.4f} mm, transit "
-              f"{geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, step "
-              f"{geom.max_delta_t:.3g} s, cavitation pressure "
-              f"{spec.physics.cavitation_pressure:g} Pa")
+              f"{geom.transit_time:.3g} s, {until}, step {geom.max_delta_t:.3g} s, "
+              f"cavitation pressure {spec.physics.cavitation_pressure:g} Pa")
         return EXIT_OK
     print(f"case {args.out}: {geom.solver}, {geom.cells} cells, a = {geom.a * 1e3:.4f} mm, "
           f"transit {geom.transit_time:.3g} s, end time {geom.end_time:.3g} s, "

@@ -78,7 +78,8 @@ class MetricsRecord(BaseModel):
         "case folder was removed mid-run), monitor_error, interrupted (Ctrl-C, SIGTERM), "
         "monitor_killed (status interrupted: metrics.json was left running by a killed run, "
         "its run lock free); a batch adds build_error, ramp_start_error, run_error, "
-        "worker_lost", "End reason")
+        "worker_lost; a cycle of passes (supply.mode = \"rig\") ends periodic, limit_cycle, "
+        "passes_max", "End reason")
     steady: bool | None = _text("A steady-state test stopped the run", "Steady state reached")
     solver_exit_code: int | None = _text("The solver's exit code", "Solver exit code")
     simulated_time_s: float | None = _key("Simulated time at the last write", "s",
@@ -220,6 +221,34 @@ class MetricsRecord(BaseModel):
                                            "Flow through the contact, u hc 2a", "nl/s", 1e12)
     contact_flow_over_inflow: float | None = _key("Contact flow over the oil inflow", "1",
                                                   "Contact flow / oil inflow", "%", 100.0)
+    # ---------------------------------------------------------------- a cycle of passes
+    cycle_end_reason: str | None = _text(
+        "How a cycle of passes (supply.mode = \"rig\") ended: periodic (settled), "
+        "limit_cycle, passes_max, wall_limit, diverged, interrupted", "Cycle end reason")
+    cycle_passes: int | None = _text("Passes (ball revolutions) the cycle made",
+                                     "Cycle passes")
+    cycle_period_passes: int | None = _text(
+        "The settled cycle's period in passes (1: periodic, every pass alike)",
+        "Cycle period (passes)")
+    cycle_pass_time_s: float | None = _key(
+        "A pass of the cycle: a K-th of the disc's revolution", "s", "Cycle pass time")
+    cycle_arcs: int | None = _text("K: the disc track's arcs, a pass each (round(r / R))",
+                                   "Disc track arcs (passes a disc revolution)")
+    cycle_inlet_supply_m3_s: float | None = _key(
+        "The oil the inlet took in over the last pass, per second (whole contact)", "m3/s",
+        "Inlet supply, last pass", "nl/s", 1e12)
+    oil_disc_track_m3: float | None = _key("Oil on the disc's track after the last pass",
+                                           "m3", "Oil on the disc's track", "nl", 1e12)
+    oil_ball_track_m3: float | None = _key("Oil on the ball's track after the last pass",
+                                           "m3", "Oil on the ball's track", "nl", 1e12)
+    oil_rig_m3: float | None = _key(
+        "Oil on the rig after the last pass: the tracks and the contact's domain", "m3",
+        "Oil on the rig (tracks and contact)", "nl", 1e12)
+    oil_rig_initial_m3: float | None = _key("Oil on the rig at the cycle's start", "m3",
+                                            "Oil on the rig at the start", "nl", 1e12)
+    oil_rig_balance_error: float | None = _key(
+        "The rig's oil now less at the start, over at the start (round-off: nothing is "
+        "added or lost)", "1", "Rig oil balance error", "%", 100.0)
     # ---------------------------------------------------------------- the run's cost, mesh
     cells: int | None = _text("Cells of the mesh", "Cells")
     time_steps: int | None = _text("Time steps the solver took", "Time steps")

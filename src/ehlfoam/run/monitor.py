@@ -176,6 +176,10 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
     path = Path(case).absolute()
     if not path.is_dir():
         raise FileNotFoundError(f"case folder {path} does not exist")
+    if is_thin_film_case(path) and load_spec_of(path).supply.mode == "rig":
+        from ehlfoam.run.cycle import run_cycle_case   # a cycle of passes (issue 75)
+        return run_cycle_case(path, wall_limit=wall_limit, on_sample=on_sample, on_note=on_note,
+                              extend_transits=extend_transits, crashed=crashed_record)
     if is_thin_film_case(path):   # the gap-averaged model, no solver (issue 74)
         return run_thin_film_case(path, wall_limit=wall_limit, on_sample=on_sample,
                                   extend_transits=extend_transits, crashed=crashed_record,

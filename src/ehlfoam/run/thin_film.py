@@ -48,7 +48,7 @@ from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state, save_state
 
-__all__ = ["STATE_FILE", "run_thin_film_case"]
+__all__ = ["STATE_FILE", "run_thin_film_case", "start_of"]
 
 #: the state a thin-film run ends with, in the case folder
 STATE_FILE = "state.npz"
@@ -89,7 +89,7 @@ def run_thin_film_case(case: str | Path, *, wall_limit: float | None = None,
                            extend_transits)
 
 
-def _start(path: Path) -> tuple[ThinFilmSolution | None, float, list[Sample], float | None]:
+def start_of(path: Path) -> tuple[ThinFilmSolution | None, float, list[Sample], float | None]:
     """Where the run starts: (the state, its time [s], the samples before it, the oil at
     t = 0 [m3, whole contact] when an earlier run knew it). An earlier run's state.npz, else
     the state the case was written to start from, else the spec's puddle (None)."""
@@ -107,7 +107,7 @@ def _start(path: Path) -> tuple[ThinFilmSolution | None, float, list[Sample], fl
 
 def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
                 on_sample: OnSample | None, extend: float | None) -> MetricsRecord:
-    start, t0, history, initial = _start(path)       # before metrics.json says running
+    start, t0, history, initial = start_of(path)       # before metrics.json says running
     write_metrics(path, MetricsRecord(status="running", cells=geom.cells))
     prob = problem_from_spec(spec, GapField.load(path / "precalc"), scene_options(spec))
     m = Marcher(prob, start=start, courant=spec.thin_film.courant,

@@ -10,7 +10,7 @@ the Hertzian radius a; each field states its own (``json_schema_extra["unit"]``)
     speed = 0.008        # m/s, pure rolling
 
     [supply]             # ehlfoam.spec.sections.Supply
-    mode = "layers"      # "flooded" (ample oil), "layers" or "submerged"
+    mode = "layers"      # "flooded" (ample oil), "layers", "submerged" or "rig"
     disc_layer = 2e-6    # m
 
     [physics]            # ehlfoam.spec.sections.Physics
@@ -34,6 +34,7 @@ from pydantic import BaseModel, Field, ValidationError, model_validator
 from ehlfoam._io import read_toml
 from ehlfoam.contact.spec import PrecalcSpec
 from ehlfoam.errors import SpecError, format_validation_error, models_in
+from ehlfoam.spec.cycle import Cycle, check_rig
 from ehlfoam.spec.ladder import RUNGS, THIN_FILM_START, expand_rung
 from ehlfoam.spec.levels import FOLLOW_POLAR_RADIUS, POLAR_RING_SHARE
 from ehlfoam.spec.mesh import Mesh
@@ -93,6 +94,9 @@ class CaseSpec(BaseModel):
     thin_film: ThinFilm = Field(ThinFilm(), description='The gap-averaged model of scene = '
                                                         '"thin-film": its grid and closures '
                                                         '(the 3D scenes ignore it).')
+    cycle: Cycle = Field(Cycle(), description='The cycle of passes of supply.mode = "rig": '
+                                              'the tracks\' reflow and when the cycle ends '
+                                              '(the other supply modes ignore it).')
 
     @model_validator(mode="before")
     @classmethod
@@ -228,6 +232,7 @@ def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> Case
         raise SpecError(f"invalid case spec: contact: {err}") from None
     _check_supply_fits(spec)
     check_thin_film(spec)
+    check_rig(spec)
     _check_scene_options(spec)
     if spec.run.start == "thin-film" and spec.scene != "thin-film":
         thin_film_counterpart(spec)   # the start must exist: refused now, not after a build

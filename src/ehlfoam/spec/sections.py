@@ -33,21 +33,45 @@ class Supply(BaseModel):
     """Oil reaching the contact."""
 
     model_config = STRICT
-    mode: Literal["flooded", "layers", "submerged"] = Field(
+    mode: Literal["flooded", "layers", "submerged", "rig"] = Field(
         "flooded",
         description='How oil reaches the contact. "flooded": the whole gap height on the track '
                     'is oil at the inlet, and the case starts from a puddle (ample oil); '
                     '"layers": an oil layer on each surface, on the track only, carried in by '
                     'the walls (a starved supply); "submerged": the contact runs in a bath, the '
                     'domain starts full of oil and oil flows in through every open boundary, '
-                    'so that the only gas is what the scene makes.')
+                    'so that the only gas is what the scene makes; "rig": the oil on the rig '
+                    '(disc_oil and ball_oil, or the mean layers disc_layer and ball_layer over '
+                    'the track at the start) and nothing added: each pass takes in what the '
+                    'passes before left on the tracks after its reflow over a revolution (the '
+                    '[cycle] table; scene = "thin-film" only).')
     disc_layer: float = Field(
         2e-6, ge=0.0, le=1e-3,
-        description='Thickness of the oil layer the disc carries into the inlet ("layers" mode).',
+        description='Thickness of the oil layer the disc carries into the inlet ("layers" '
+                    'mode); in "rig" mode the mean layer on its track at the start.',
         json_schema_extra={"unit": "m"})
     ball_layer: float = Field(
         2e-6, ge=0.0, le=1e-3,
-        description='Thickness of the oil layer the ball carries into the inlet ("layers" mode).',
+        description='Thickness of the oil layer the ball carries into the inlet ("layers" '
+                    'mode); in "rig" mode the mean layer on its track at the start.',
+        json_schema_extra={"unit": "m"})
+    disc_oil: float | None = Field(
+        None, gt=0.0, le=1e-5,
+        description='The oil on the disc\'s track at the start ("rig" mode), spread evenly '
+                    'over the track (|y| < track_half_width, the circle of track_radius); '
+                    'none: disc_layer over the track.',
+        json_schema_extra={"unit": "m3"})
+    ball_oil: float | None = Field(
+        None, gt=0.0, le=1e-5,
+        description='The oil on the ball\'s track at the start ("rig" mode), spread evenly '
+                    'over it (|y| < track_half_width, the great circle of contact.radius); '
+                    'none: ball_layer over the track.',
+        json_schema_extra={"unit": "m3"})
+    track_radius: float = Field(
+        0.039, gt=0.0, le=1.0,
+        description='Radius of the disc\'s track ("rig" mode): a revolution takes '
+                    '2 pi track_radius / u (the reference rig\'s, about 39 mm). Larger than '
+                    'the domain\'s length (domain.upstream + domain.downstream).',
         json_schema_extra={"unit": "m"})
     track_half_width: float = Field(
         3e-4, gt=0.0, le=0.1,

@@ -164,7 +164,7 @@ def check_thin_film(spec: CaseSpec) -> None:
     p, tf, d = spec.physics, spec.thin_film, spec.domain
     if spec.supply.mode == "submerged":
         problems.append('supply.mode = "submerged" does not apply to scene = "thin-film" '
-                        '(valid: "layers" or "flooded"; the model has outer air)')
+                        '(valid: "layers", "flooded" or "rig"; the model has outer air)')
     if d.symmetry != "half":
         problems.append(f'domain.symmetry = "{d.symmetry}" does not apply to scene = '
                         '"thin-film" (the model is marched on the half domain: "half")')
@@ -206,8 +206,14 @@ def check_thin_film(spec: CaseSpec) -> None:
 def thin_film_cpu_s(spec: CaseSpec) -> float:
     """A rough CPU cost [s] of a thin-film run to its time limit (for a batch's ordering and
     first ETA): some 1 us per cell and step (a sparse solve a step), at
-    1 / thin_film.courant steps per cell's transit at u, over the run's time limit."""
+    1 / thin_film.courant steps per cell's transit at u, over the run's time limit (a
+    cycle of passes, supply.mode = "rig": over cycle.passes_max passes)."""
     cell = thin_film_cell(spec)
     steps = (spec.end_time * spec.speed / (cell * spec.a)) / spec.thin_film.courant
+    if spec.supply.mode == "rig":   # a cycle: its passes, a K-th of a disc turn each
+        r = spec.supply.track_radius
+        arcs = max(1, round(r / spec.contact.radius))
+        steps = spec.cycle.passes_max * 2 * math.pi * r / (
+            arcs * spec.thin_film.courant * cell * spec.a)
     return 1.0 + 1e-6 * thin_film_cells(spec) * steps if math.isfinite(steps) else 1.0
 

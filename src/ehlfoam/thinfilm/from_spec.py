@@ -29,6 +29,7 @@ import numpy as np
 
 from ehlfoam._io import atomic_write_json
 from ehlfoam.spec.case import CaseSpec
+from ehlfoam.spec.cycle import rig_layers
 from ehlfoam.spec.thin_film import thin_film_cell
 from ehlfoam.thinfilm.march import solve_thin_film
 from ehlfoam.thinfilm.problem import ThinFilmProblem
@@ -96,7 +97,8 @@ def problem_from_spec(spec: CaseSpec, gap: Callable[[np.ndarray, np.ndarray], np
                       options: RegionOptions = RegionOptions()) -> ThinFilmProblem:
     """The thin-film problem of a case spec on the gap h(x, y) [m]: its contact's speed, its
     oil, wetting and supply ("layers": both layers on the track; "flooded": the whole inlet
-    gap on the track), its island and initial puddle, its cavitation pressure (the outlet
+    gap on the track; "rig": the mean layers on the tracks at the start, which a cycle's
+    passes replace, :mod:`ehlfoam.run.cycle`), its island and initial puddle, its cavitation pressure (the outlet
     model, as ``options.cavitation`` or the scene says), gridded as ``options`` say.
 
     Raises ValueError naming the parameter, its value and the valid range: a supply mode the
@@ -107,11 +109,13 @@ def problem_from_spec(spec: CaseSpec, gap: Callable[[np.ndarray, np.ndarray], np
     _check_grid(options, spec.domain.island_radius)
     if sup.mode == "layers":
         supply = sup.disc_layer + sup.ball_layer
+    elif sup.mode == "rig":   # the first pass's: the mean layers on the track
+        supply = sum(rig_layers(spec))
     elif sup.mode == "flooded":
         supply = float(gap(np.array([x_min * a]), np.array([0.0]))[0])
     else:
-        raise ValueError(f"supply.mode = {sup.mode!r}: the thin-film model takes 'layers' or "
-                         "'flooded'")
+        raise ValueError(f"supply.mode = {sup.mode!r}: the thin-film model takes 'layers', "
+                         "'flooded' or 'rig'")
     cavitation = options.cavitation
     if cavitation is None:
         cavitation = spec.scene in CAVITATING_SCENES

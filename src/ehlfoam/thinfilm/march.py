@@ -66,6 +66,7 @@ throughout.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -86,7 +87,9 @@ class Marcher:
 
     It keeps the oil in the domain exactly: the supply it took in and what left through the
     outlet and the side since its start [m3, half domain] (:attr:`oil_in`,
-    :attr:`oil_out_outlet`, :attr:`oil_out_side`), step by step."""
+    :attr:`oil_out_outlet`, :attr:`oil_out_side`), step by step, and what left through the
+    outlet on each row (:attr:`oil_out_rows`, the profile the contact leaves behind).
+    :meth:`set_supply` changes the supply between steps (a cycle's next pass)."""
 
     def __init__(self, prob: ThinFilmProblem, *, start: ThinFilmSolution | None = None,
                  courant: float = 0.25, transit_length: float | None = None):
@@ -108,11 +111,21 @@ class Marcher:
         self.q_in = float(self.ops.q_supply.sum())
         self.oil_start = self.oil()
         self.oil_in = self.oil_out_outlet = self.oil_out_side = 0.0
+        self.oil_out_rows = np.zeros(len(grid.y))       # the outlet's, row by row [m3]
         self.flooded = (self.c >= h * (1.0 - 1e-9)) & ~grid.island
         self.p = np.full(self.c.shape, np.nan)
         self.steps = 0
         self.history: list[dict] = []
         self._out = self._dry = self._cavitated = 0.0
+
+    def set_supply(self, layers: tuple[np.ndarray, np.ndarray]) -> None:
+        """From the next step on, the walls bring in the lateral profiles ``layers`` (disc,
+        ball) [m] on the grid's rows (:attr:`ThinFilmProblem.supply_layers`); the oil,
+        the step and the accounts go on."""
+        self.prob = replace(self.prob, supply_layers=(np.asarray(layers[0], float),
+                                                      np.asarray(layers[1], float)))
+        self.ops = Operators(self.prob, self.grid)
+        self.q_in = float(self.ops.q_supply.sum())
 
     @property
     def time(self) -> float:
@@ -134,6 +147,7 @@ class Marcher:
         self.steps += 1
         self.oil_in += self.q_in * self.dt
         self.oil_out_outlet += s.q_outlet * self.dt
+        self.oil_out_rows += s.outlet_rows * self.dt
         self.oil_out_side += s.q_side * self.dt
         self._out += (s.q_outlet + s.q_side) * self.dt
         self._dry += int(s.opened.sum())

@@ -43,8 +43,13 @@ class Operators:
         self.normal_sigma = 1.5 if prob.normal_length is None else prob.normal_length / d
         self.film = prob.film
         self.cap = prob.film * self.h                  # what a meniscus cell passes on [m]
-        on_track = np.clip((prob.track_half_width - (grid.y - d / 2)) / d, 0.0, 1.0)
-        self.q_supply = u * prob.supply * on_track * d  # into column 0 [m3/s]
+        if prob.supply_layers is None:
+            on_track = np.clip((prob.track_half_width - (grid.y - d / 2)) / d, 0.0, 1.0)
+            self.q_supply = u * prob.supply * on_track * d  # into column 0 [m3/s]
+            incoming = prob.supply * on_track           # the layers coming in, each row [m]
+        else:                                           # lateral profiles (a cycle's)
+            incoming, on_track = prob.supply_rows(grid.y)
+            self.q_supply = u * incoming * d
         self.young_laplace = 2.0 * prob.surface_tension * cos_t   # pcap = -it / h [N/m]
         self.theta_a = None if prob.advancing_angle is None else np.radians(prob.advancing_angle)
         self.dry = 1.0 - on_track[:, None]             # walls coming in dry: off the track
@@ -54,8 +59,7 @@ class Operators:
         # the oil an open cell holds as the walls' layers, not as meniscus: the supply's
         # layers ahead of the contact, the films elsewhere [m]
         ahead = (grid.x < 0)[None, :] & np.ones_like(self.island)
-        self.layers = np.where(ahead, np.maximum(prob.supply * on_track[:, None], self.cap),
-                               self.cap)
+        self.layers = np.where(ahead, np.maximum(incoming[:, None], self.cap), self.cap)
 
     def pull_factor(self, flooded: np.ndarray) -> np.ndarray | float:
         """The dynamic menisci's pressure on every cell, a factor on the static one. The
@@ -197,22 +201,24 @@ class Operators:
                     cavitated |= low
                     flooded = flooded & ~low
                     continue
-            dc, q_outlet, q_side = self.move(flooded, p, c, dt, faces, cavity)
+            dc, q_outlet, q_side, rows = self.move(flooded, p, c, dt, faces, cavity,
+                                                   by_row=True)
             dry = flooded & (c + dc < 0.0)
             if not dry.any():
-                return Step(p, dc, q_outlet, q_side, opened, cavitated, cavity)
+                return Step(p, dc, q_outlet, q_side, opened, cavitated, cavity, rows)
             opened |= dry
             flooded = flooded & ~dry
         raise RuntimeError("the flooded set did not settle within a step")
 
     def move(self, flooded: np.ndarray, p: np.ndarray, c: np.ndarray, dt: float,
-             faces: "_Faces", cavity: np.ndarray | None = None):
+             faces: "_Faces", cavity: np.ndarray | None = None, by_row: bool = False):
         """The change of the oil in every cell over dt [m] and the fluxes leaving the
         domain through the outlet and the side [m3/s], the menisci at ``faces``. An open
         cell gives no more than it holds: what the flooded region draws from it is cut back
         first (the flooded cell runs short of a full gap), the films and layers it passes on
         only when that is not enough. A cavity's cells (``cavity``) pass on all the oil they
-        hold, as no air meniscus holds it back."""
+        hold, as no air meniscus holds it back. ``by_row``: the outlet's flux on each row
+        [m3/s] too, a fourth item."""
         u, d = self.u, self.d
         if cavity is None:
             cavity = np.zeros_like(flooded)
@@ -268,15 +274,17 @@ class Operators:
                     q_last = q_last * scale[:, -1]
                     q_side = q_side * scale[-1]
         net = _net(qx, qy, q_last, q_side, self.q_supply)
-        return net * dt / (d * d), float(q_last.sum()), float(q_side.sum())
+        out = net * dt / (d * d), float(q_last.sum()), float(q_side.sum())
+        return (*out, q_last) if by_row else out
 
 
 class Step(NamedTuple):
     """What one step did: p [Pa, gauge] on the flooded cells (NaN elsewhere), the change of
     every cell's oil [m], the fluxes leaving through the outlet and the side [m3/s], the
     flooded cells it opened as they ran dry, those it opened to gas (below the cavitation
-    pressure), and the cavities' cells (the open cells the region enclosed, at the
-    cavitation pressure)."""
+    pressure), the cavities' cells (the open cells the region enclosed, at the
+    cavitation pressure) and the outlet's flux on each row [m3/s] (what the walls carry out
+    of the last column: the lateral profile of the oil the contact leaves behind)."""
 
     p: np.ndarray
     dc: np.ndarray
@@ -285,6 +293,7 @@ class Step(NamedTuple):
     opened: np.ndarray
     cavitated: np.ndarray
     cavity: np.ndarray
+    outlet_rows: np.ndarray | None = None
 
 
 class _Faces(NamedTuple):

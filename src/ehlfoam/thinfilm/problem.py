@@ -5,10 +5,14 @@ units. The model itself: :mod:`ehlfoam.thinfilm.march`."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
+
+#: A row whose supply layers are below this share of the profile's largest counts as dry
+#: walls coming in (the advancing angle applies there).
+DRY_SHARE = 0.01
 
 
 def landau_levich(eta: float, u: float, sigma: float) -> float:
@@ -95,6 +99,7 @@ class ThinFilmProblem:
     advancing_angle: float | None = None
     meniscus_position: Literal["sub-cell", "cell"] = "sub-cell"
     cavitation_pressure: float | None = None
+    supply_layers: tuple[np.ndarray, np.ndarray] | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         span = min(self.y_max / 2, (self.x_range[1] - self.x_range[0]) / 8)
@@ -135,6 +140,42 @@ class ThinFilmProblem:
         for name, (value, ok, valid) in checks.items():
             if not ok:
                 raise ValueError(f"{name} = {value!r} is out of range: must be {valid}")
+        if self.supply_layers is not None:
+            self._check_layers()
+
+    @property
+    def rows(self) -> int:
+        """The grid's rows across y (:class:`Grid`)."""
+        return int(round(self.y_max / self.cell))
+
+    def _check_layers(self) -> None:
+        ny = self.rows
+        if len(self.supply_layers) != 2:
+            raise ValueError(f"supply_layers has {len(self.supply_layers)} profiles: must be "
+                             "(disc, ball)")
+        for name, layer in zip(("disc", "ball"), self.supply_layers):
+            layer = np.asarray(layer)
+            if layer.shape != (ny,):
+                raise ValueError(f"supply_layers ({name}) has shape {layer.shape}: must be "
+                                 f"({ny},), a layer on each of the grid's rows")
+            bad = ~(np.isfinite(layer) & (layer >= 0))
+            if bad.any():
+                raise ValueError(f"supply_layers ({name}) = {float(layer[bad][0]):g} m on row "
+                                 f"{int(np.argmax(bad))} is out of range: must be finite "
+                                 "and >= 0 m on every row")
+
+    def supply_rows(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The layers the walls bring in on the rows at ``y`` [m] (both walls together,
+        [m]) and each row's share of wet wall (0-1; off the track 0): the profiles of
+        ``supply_layers``, or ``supply`` on the track."""
+        if self.supply_layers is None:
+            d = self.cell
+            on_track = np.clip((self.track_half_width - (y - d / 2)) / d, 0.0, 1.0)
+            return self.supply * on_track, on_track
+        total = np.asarray(self.supply_layers[0], float) + np.asarray(self.supply_layers[1],
+                                                                         float)
+        top = float(total.max()) if total.size else 0.0
+        return total, (total > DRY_SHARE * top).astype(float) if top > 0 else 0.0 * total
 
     @property
     def film(self) -> float:

@@ -1,0 +1,282 @@
+"""The cycle of passes of a thin-film case whose supply is the oil on the rig
+(``supply.mode = "rig"``): the supply as an outcome.
+
+Nobody sets the supply: the inlet of pass n + 1 takes in what pass n (and, on the disc,
+the passes a revolution before) left on the tracks, levelled over a revolution
+(:mod:`ehlfoam.tracks`). A pass is a ball revolution (a K-th of the disc's, K = round(r /
+R), :mod:`ehlfoam.tracks.rig`); the contact's march goes on from its state through every
+pass, its supply the tracks' layers on its rows. The cycle ends:
+
+- ``periodic``: over the last max(K, 2) passes the supply the inlet took in and the oil in
+  the contact's domain changed by less than ``cycle.tolerance`` (relative) from one pass to
+  the next, the state stayed the same, and the contact laid back what it took in within
+  it;
+- ``limit_cycle``: not so, but the passes' supply, oil and state repeat with a period of 2
+  to ``cycle.period_max`` passes within the tolerance, twice over (3 periods seen);
+- ``passes_max`` (``cycle.passes_max``), ``wall_limit`` (``run.wall_limit``), ``diverged``
+  (the march failed), ``interrupted`` (Ctrl-C, SIGTERM).
+
+Every pass writes a row of ``DIR/cycle.csv`` (its supply, state, inlet meniscus, bubble,
+the oil in the flooded region, the contact's domain and on each track, the rig's oil and
+its balance), the contact's ``state.npz`` and the tracks' ``tracks.npz``: a cycle that is
+stopped goes on from its last pass when run again, nothing lost (a pass cut short is made
+again: its state is not written, so the contact's and the tracks' oil stay in step). ``metrics.json`` holds the
+last pass's flow pattern (the thin-film run's keys) and the cycle's summary (``cycle_*``,
+``oil_rig_*`` keys). Volumes are the whole contact's and the whole tracks' (twice the half
+width marched).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import signal
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ehlfoam._io import atomic_write_text
+from ehlfoam.case.geometry import CaseGeometry, load_geometry, load_spec_of
+from ehlfoam.case.ownership import hold_run_lock
+from ehlfoam.errors import SpecError
+from ehlfoam.gap.field import GapField
+from ehlfoam.metrics.record import MetricsRecord, write_metrics
+from ehlfoam.run.fields import Sample
+from ehlfoam.run.history import write_history
+from ehlfoam.run.thin_film import STATE_FILE, start_of
+from ehlfoam.run.thin_film_record import Accounts, sample, thin_film_record
+from ehlfoam.spec.case import CaseSpec
+from ehlfoam.spec.cycle import rig_layers
+from ehlfoam.thinfilm.from_spec import problem_from_spec, scene_options
+from ehlfoam.thinfilm.march import Marcher
+from ehlfoam.thinfilm.state import save_state
+from ehlfoam.tracks.rig import Rig, Tracks
+
+__all__ = ["CYCLE_FILE", "TRACKS_FILE", "cycle_end", "rig_of", "run_cycle_case"]
+
+#: in the case folder: a row a pass, and the tracks' layers after the last pass
+CYCLE_FILE, TRACKS_FILE = "cycle.csv", "tracks.npz"
+
+OnPass = Callable[[dict], None]
+
+
+def rig_of(spec: CaseSpec, m: Marcher) -> Rig:
+    """The rig of a "rig" spec around the march ``m`` (its grid's rows and step)."""
+    c, d = spec.cycle, m.grid.cell
+    rows = len(m.grid.y)
+    side = (c.side if c.side is not None else 3.0 * spec.domain.side) * spec.a
+    return Rig(track_radius=spec.supply.track_radius, ball_radius=spec.contact.radius,
+               speed=spec.speed, surface_tension=spec.physics.surface_tension,
+               viscosity=spec.oil_viscosity, row=d, rows=rows,
+               width_rows=max(rows, 3, int(round(side / d))), step=m.dt, refine=c.refine,
+               precursor=c.precursor, reflow_steps=c.reflow_steps, centrifugal=c.centrifugal,
+               density=spec.oil_density, disc_share=c.disc_share)
+
+
+def run_cycle_case(case: str | Path, *, wall_limit: float | None = None,
+                   on_sample: Callable[[Sample, CaseGeometry], None] | None = None,
+                   on_pass: OnPass | None = None,
+                   crashed: Callable[[Path], MetricsRecord | None] | None = None,
+                   on_note: Callable[[str], None] | None = None,
+                   extend_transits: float | None = None) -> MetricsRecord:
+    """Run the cycle of the "rig" thin-film case in ``case`` (module docstring) under its
+    run lock; ``on_sample`` gets each pass's last sample, ``on_pass`` its row of
+    cycle.csv, ``crashed`` and ``on_note`` as :func:`ehlfoam.run.thin_film.
+    run_thin_film_case`'s. ``extend_transits`` is refused (:class:`SpecError`): a cycle
+    goes on by its passes (raise ``cycle.passes_max`` and run it again). Returns the record
+    written."""
+    if extend_transits is not None:
+        raise SpecError(f"extend_transits = {extend_transits:g} does not apply to a cycle of "
+                        "passes (supply.mode = \"rig\"): raise cycle.passes_max and run it "
+                        "again, it goes on from its last pass")
+    path = Path(case).absolute()
+    spec, geom = load_spec_of(path), load_geometry(path)
+    with hold_run_lock(path):
+        if crashed is not None and crashed(path) is not None and on_note:
+            on_note(f"the earlier cycle of {path} was killed before it ended: marked "
+                    "interrupted; this run goes on from its last pass")
+        return _cycle(path, spec, geom, wall_limit or spec.run.wall_limit, on_sample,
+                      on_pass)
+
+
+def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
+           on_sample, on_pass) -> MetricsRecord:
+    start, t0, history, initial = start_of(path)
+    write_metrics(path, MetricsRecord(status="running", cells=geom.cells))
+    prob = problem_from_spec(spec, GapField.load(path / "precalc"), scene_options(spec))
+    m = Marcher(prob, start=start, courant=spec.thin_film.courant,
+                transit_length=spec.run.transit_length * spec.a)
+    rig = rig_of(spec, m)
+    rows = _read_rows(path / CYCLE_FILE)
+    if (path / TRACKS_FILE).is_file() and rows:
+        tracks = Tracks.load(path / TRACKS_FILE)
+        rig_initial = float(rows[0]["oil_rig_initial_m3"])
+    else:
+        tracks = Tracks.uniform(rig, *rig_layers(spec), spec.supply.track_half_width)
+        rows, history = [], []
+        rig_initial = 2.0 * (sum(tracks.oil(rig)) + m.oil())
+    first = before = Accounts.of(m, t0)
+    oil_start = m.oil()
+    reason, failure, period = None, None, None
+    t_wall = time.monotonic()
+    previous = signal.getsignal(signal.SIGTERM)
+    handled = _on_sigterm()
+    try:
+        while tracks.passes < spec.cycle.passes_max:
+            t_pass = time.monotonic()
+            inlet = tracks.inlet(rig)
+            m.set_supply(inlet)
+            m.oil_out_rows[:] = 0.0
+            took, side0 = m.oil_in, m.oil_out_side
+            try:
+                for _ in range(rig.pass_steps):
+                    m.step()
+                if not np.isfinite(m.c).all():
+                    raise FloatingPointError("the oil content is no longer finite")
+            except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
+                failure = err
+                break
+            took, side = m.oil_in - took, m.oil_out_side - side0
+            s, before = sample(m, t0, geom, before)
+            history.append(s)
+            if on_sample:
+                on_sample(s, geom)
+            arc = tracks.next_arc
+            tracks.lay(rig, m.oil_out_rows, side)
+            row = _row(tracks, rig, m, s, arc, took, float(m.oil_out_rows.sum()) + side,
+                       rig_initial, time.monotonic() - t_pass, inlet)
+            rows.append(row)
+            _save(path, rows, tracks, m)
+            write_history(path, history)
+            if on_pass:
+                on_pass(row)
+            reason, period = cycle_end(rows, rig.arcs, spec.cycle.tolerance,
+                                       spec.cycle.period_max)
+            if reason:
+                break
+            if time.monotonic() - t_wall > wall_limit:
+                reason = "wall_limit"
+                break
+    except KeyboardInterrupt:   # the last pass's state and tracks stay: it goes on from them
+        reason = "interrupted"
+    finally:
+        if handled:
+            signal.signal(signal.SIGTERM, previous)
+    wall = time.monotonic() - t_wall
+    if failure is not None:
+        reason = "diverged"
+    reason = reason or "passes_max"
+    status = {"diverged": "failed", "interrupted": "interrupted"}.get(reason, "finished")
+    if not history:
+        s, before = sample(m, t0, geom, before)
+        history.append(s)
+    record = thin_film_record(
+        geom, history, status=status, reason=reason, steady_kind=None, start=first,
+        end=Accounts.of(m, t0), oil_start=oil_start, oil_end=m.oil(),
+        oil_initial=initial if initial is not None else 2.0 * oil_start, steps=m.steps,
+        dt=m.dt, wall_s=wall)
+    last = rows[-1] if rows else {}
+    disc, ball = tracks.oil(rig)
+    rig_now = 2.0 * (disc + ball + m.oil())
+    record = record.updated(
+        steady=reason == "periodic", cycle_end_reason=reason, cycle_passes=len(rows),
+        cycle_period_passes=period, cycle_pass_time_s=rig.pass_time,
+        cycle_arcs=rig.arcs, cycle_inlet_supply_m3_s=last.get("inlet_supply_m3_s"),
+        oil_disc_track_m3=2.0 * disc, oil_ball_track_m3=2.0 * ball, oil_rig_m3=rig_now,
+        oil_rig_initial_m3=rig_initial,
+        oil_rig_balance_error=abs(rig_now - rig_initial) / rig_initial)
+    if failure is not None:
+        record = record.updated(reason="the march failed: " + " ".join(
+            f"{type(failure).__name__}: {failure}".split())[:500])
+    write_metrics(path, record)
+    return record
+
+
+def cycle_end(rows: list[dict], arcs: int, tol: float, period_max: int
+              ) -> tuple[str | None, int | None]:
+    """How the cycle's passes ``rows`` (cycle.csv's) end: ("periodic", 1), ("limit_cycle",
+    period) or (None, None) to go on (module docstring)."""
+    def series(key: str) -> np.ndarray:
+        return np.array([float(r[key]) for r in rows])
+
+    n = len(rows)
+    need = max(arcs, 2)
+    if n < need + 1:
+        return None, None
+    took, oil, laid = series("inlet_m3"), series("oil_domain_m3"), series("laid_m3")
+    states = [r["state"] for r in rows]
+    scale_t = max(np.abs(took[-need - 1:]).max(), 1e-300)
+    scale_o = max(np.abs(oil[-need - 1:]).max(), 1e-300)
+    steady = (np.abs(np.diff(took[-need - 1:])).max() <= tol * scale_t
+              and np.abs(np.diff(oil[-need - 1:])).max() <= tol * scale_o
+              and abs(laid[-1] - took[-1]) <= tol * scale_t
+              and len(set(states[-need - 1:])) == 1)
+    if steady:
+        return "periodic", 1
+    for p in range(2, period_max + 1):
+        if n < 3 * p:
+            break
+        a, b = slice(n - 2 * p, n), slice(n - 3 * p, n - p)
+        if (np.abs(took[a] - took[b]).max() <= tol * scale_t
+                and np.abs(oil[a] - oil[b]).max() <= tol * scale_o
+                and states[a] == states[b]):
+            return "limit_cycle", p
+    return None, None
+
+
+def _row(tracks: Tracks, rig: Rig, m: Marcher, s: Sample, arc: int, took: float,
+         laid: float, rig_initial: float, wall: float, inlet) -> dict:
+    """cycle.csv's row of the pass just made (whole contact, whole tracks)."""
+    disc, ball = tracks.oil(rig)
+    p = s.pattern
+    rig_now = 2.0 * (disc + ball + m.oil())
+    width = rig.row * float(np.count_nonzero(inlet[0] + inlet[1]))
+    return {
+        "pass": tracks.passes, "time_s": s.time, "disc_arc": arc,
+        "inlet_supply_m3_s": 2.0 * took / rig.pass_time, "inlet_m3": 2.0 * took,
+        "inlet_disc_layer_mean_m": float(inlet[0].sum()) * rig.row / width if width else 0.0,
+        "inlet_ball_layer_mean_m": float(inlet[1].sum()) * rig.row / width if width else 0.0,
+        "laid_m3": 2.0 * laid, "state": p.get("state"),
+        "inlet_meniscus_distance_over_a": p.get("inlet_meniscus_distance_over_a"),
+        "inlet_meniscus_shape": p.get("inlet_meniscus_shape"),
+        "flooded_width_over_a": p.get("flooded_width_over_a"),
+        "bubble_length_over_a": p.get("bubble_length_over_a"),
+        "wake_open": p.get("wake_open"),
+        "oil_region_m3": 2.0 * m.history[-1]["oil_m3"] if m.history else None,
+        "oil_domain_m3": 2.0 * m.oil(), "oil_disc_track_m3": 2.0 * disc,
+        "oil_ball_track_m3": 2.0 * ball, "oil_rig_m3": rig_now,
+        "oil_rig_initial_m3": rig_initial,
+        "oil_rig_balance_error": abs(rig_now - rig_initial) / rig_initial,
+        "wall_s": wall}
+
+
+def _save(path: Path, rows: list[dict], tracks: Tracks, m: Marcher) -> None:
+    """cycle.csv, the tracks and the contact's state after a pass, each atomically."""
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=list(rows[0]))
+    writer.writeheader()
+    writer.writerows(rows)
+    tracks.save(path / TRACKS_FILE)
+    save_state(m.solution(), path / STATE_FILE)
+    atomic_write_text(path / CYCLE_FILE, buf.getvalue())
+
+
+def _read_rows(path: Path) -> list[dict]:
+    """The rows of an earlier cycle.csv (none without one)."""
+    if not path.is_file():
+        return []
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _on_sigterm() -> bool:
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+    try:
+        signal.signal(signal.SIGTERM, interrupt)
+    except ValueError:
+        return False
+    return True
+
