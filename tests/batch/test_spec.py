@@ -156,18 +156,18 @@ def test_ramp_steps_up_then_down():
         (0.008, "down"), (0.005, "down"), (0.008, "up")]
 
 
-@pytest.mark.parametrize("name, n_cases", [("default", 23), ("regime", 34)])
+@pytest.mark.parametrize("name, n_cases", [("default", 21), ("regime", 34)])
 def test_shipped_batch_specs_expand(name, n_cases):
     batch, plan = load_plan(ROOT / "examples" / "batches" / f"{name}.toml")
     assert batch.name == name and len(plan) == n_cases
     at_ref = [pc for pc in plan
               if pc.params["contact.temperature"] == 40 and pc.params["contact.load"] == 20]
     assert len(at_ref) >= 5
-    if name == "default":      # the thin-film map at medium, the 3D checks on coarse meshes
-        assert {(pc.spec.scene, pc.spec.mesh.resolution) for pc in plan} == {
-            ("thin-film", "medium"), ("interface", "coarse")}
+    if name == "default":      # the thin-film map at medium, its 3D checks on the coarse mesh
+        assert {pc.spec.rung for pc in plan} == {"thin-film-medium"}
         assert {pc.params["contact.speed"] for pc in plan} >= {0.008, 0.017}
         assert all(pc.ramp is None for pc in plan)
+        assert (batch.confirm.rung, batch.confirm.scene) == ("coarse", "gas-release")
     else:
         assert all(pc.spec.mesh.resolution == "coarse" for pc in plan)
         sweep = [pc for pc in at_ref if pc.ramp is None]
@@ -182,9 +182,8 @@ def test_shipped_batch_specs_keep_their_case_ids():
     display-unit keys gave."""
     _, plan = load_plan(ROOT / "examples" / "batches" / "default.toml")
     ids = [pc.id for pc in plan]
-    assert ids[:2] == ["u05.0_s0.45um_T40_F20_tf-medium_transits_max150",
-                       "u05.0_s1um_T40_F20_tf-medium_transits_max150"]
-    assert ids[-2:] == [f"u{u}_s0.45um_T40_F20_coarse_transits_max3" for u in ("08.0", "17.0")]
+    assert ids[:2] == ["u05.0_s0.45um_T40_F20_tf-medium", "u05.0_s1um_T40_F20_tf-medium"]
+    assert len(ids) == 21 and ids[-1] == "u60.0_s2um_T40_F20_tf-medium"
     _, plan = load_plan(ROOT / "examples" / "batches" / "breakthrough_release_low.toml")
     assert [pc.id for pc in plan] == [f"rampR_up0{k}_u{u}_s8um_T40_F20_coarse"
                                       for k, u in enumerate(("05.0", "06.5", "08.0", "09.5"),
