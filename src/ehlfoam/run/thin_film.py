@@ -188,7 +188,7 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
 def _write_gas(path: Path, m: Marcher) -> None:
     """``DIR/gas.json``: the gas balance's budget over the march [mol, whole contact], what
     the cavities hold at the end, the budget's residual, and each transit's gas pressure of
-    the largest cavity [Pa, absolute] and held air [mol, whole contact]. A run that goes on
+    the largest cavity [Pa, absolute], the held air and the budget so far [mol, whole contact]. A run that goes on
     from its state starts its gas again at the release pressure (the state keeps the oil)."""
     g = m.gas
     rows = [(r["time_s"], r["gas_pressure_Pa"] if math.isfinite(r["gas_pressure_Pa"])
@@ -203,7 +203,8 @@ def _write_gas(path: Path, m: Marcher) -> None:
         "largest_cavity": {k: (2.0 * v if k != "pressure_Pa" else v)
                            for k, v in g.last.items()},
         "per_transit": {"time_s": [r[0] for r in rows], "pressure_Pa": [r[1] for r in rows],
-                        "held_mol": [r[2] for r in rows]}})
+                        "held_mol": [r[2] for r in rows],
+                        **{k: [2.0 * r[k] for r in m.history] for k in g.budget}}})
 
 
 def _on_sigterm() -> bool:
