@@ -46,6 +46,8 @@ With a cavitation pressure (``cavitation_pressure``, gauge) the model has an out
 flooded cell whose pressure would fall below it opens to gas, the gas the flooded region
 encloses (a cavity, the bubble behind the contact) is at it, and the walls carry the oil of
 a cavity's cells, their film content, on at u, all of it (:mod:`ehlfoam.thinfilm.cavity`).
+With a gas balance (``gas``) each cavity's pressure is that of the air it holds, exchanged
+with the oil step by step (:mod:`ehlfoam.thinfilm.gas`, :attr:`Marcher.gas`).
 
 This is the mass-conserving cavitation model of lubrication (Elrod-Adams; Jakobsson,
 Floberg and Olsson's conditions) with two changes that make it a model of this flow: the
