@@ -188,8 +188,9 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
 def _write_gas(path: Path, m: Marcher) -> None:
     """``DIR/gas.json``: the gas balance's budget over the march [mol, whole contact], what
     the cavities hold at the end, the budget's residual, and each transit's gas pressure of
-    the largest cavity [Pa, absolute], the held air and the budget so far [mol, whole contact]. A run that goes on
-    from its state starts its gas again at the release pressure (the state keeps the oil)."""
+    the largest cavity [Pa, absolute], the held air and the budget so far [mol, whole
+    contact]. A run that goes on from its state takes its cavities' air from it; its budget
+    covers this run (``held_at_start_mol``)."""
     g = m.gas
     rows = [(r["time_s"], r["gas_pressure_Pa"] if math.isfinite(r["gas_pressure_Pa"])
              else None, 2.0 * r["gas_held_mol"]) for r in m.history]
@@ -199,7 +200,8 @@ def _write_gas(path: Path, m: Marcher) -> None:
                       "saturation_pressure_Pa": g.k.ambient,
                       "release_pressure_Pa": g.k.release},
         "budget_mol": {k: 2.0 * v for k, v in g.budget.items()},
-        "held_mol": 2.0 * g.held(), "residual_mol": 2.0 * g.budget_residual(),
+        "held_mol": 2.0 * g.held(), "held_at_start_mol": 2.0 * g.start,
+        "residual_mol": 2.0 * g.budget_residual(),
         "largest_cavity": {k: (2.0 * v if k != "pressure_Pa" else v)
                            for k, v in g.last.items()},
         "per_transit": {"time_s": [r[0] for r in rows], "pressure_Pa": [r[1] for r in rows],

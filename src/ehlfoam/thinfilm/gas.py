@@ -123,6 +123,7 @@ class CavityGas:
         self.h, self.hx, self.hy = h, np.nan_to_num(hx), np.nan_to_num(hy)
         self.d, self.u = cell, speed
         self.n = np.zeros_like(h)
+        self.start = 0.0    # the air held when the budget began [mol]
         self.budget = {"released_by_diffusion_mol": 0.0,
                        "released_at_release_pressure_mol": 0.0,
                        "dissolved_by_diffusion_mol": 0.0, "dissolved_on_collapse_mol": 0.0,
@@ -136,7 +137,7 @@ class CavityGas:
     def budget_residual(self) -> float:
         """What the cavities hold less what the budget says they should [mol]."""
         b = self.budget
-        return self.held() - (b["released_by_diffusion_mol"]
+        return self.held() - self.start - (b["released_by_diffusion_mol"]
                               + b["released_at_release_pressure_mol"]
                               - b["dissolved_by_diffusion_mol"] - b["dissolved_on_collapse_mol"]
                               - b["escaped_to_air_mol"])

@@ -117,6 +117,10 @@ class Marcher:
         self.history: list[dict] = []
         self._out = self._dry = self._cavitated = 0.0
         self.gas = None if prob.gas is None else CavityGas(prob.gas, h, grid.hx, grid.hy, d, u)
+        if self.gas is not None and start is not None and start.gas is not None \
+                and start.gas.shape == h.shape:     # the air of a state on this grid
+            self.gas.n = np.where(self.cavity(), start.gas, 0.0)
+            self.gas.start = self.gas.held()
 
     @property
     def time(self) -> float:
@@ -224,7 +228,10 @@ class Marcher:
             mass_balance_error=self.mass_balance_error(),
             fill=np.where(self.flooded, 0.0, self.ops.fill(self.c, cavity))
             if self.ops.sub_cell else None,
-            cavity=cavity, cavitation_pressure=self.prob.cavitation_pressure)
+            cavity=cavity, cavitation_pressure=self.prob.cavitation_pressure,
+            gas=None if self.gas is None else self.gas.n.copy(),
+            gas_pressure=None if self.gas is None else
+            self.gas.pressure(cavity, self.c) - self.gas.k.ambient)
 
 
 def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,
