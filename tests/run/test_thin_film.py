@@ -251,3 +251,24 @@ def test_an_extension_beyond_max_steps_is_refused_before_anything_is_written(ran
     assert main(["run", str(case), "--extend", "1e6", "--quiet"]) == 2
     assert "more than run.max_steps" in capsys.readouterr().err
     assert (case / "metrics.json").read_text() == before
+
+
+def test_a_run_with_the_gas_balance_writes_its_closing_budget(ran, tmp_path):
+    """`thin_film.bubble_gas = "balance"`: the run writes gas.json, its budget (whole
+    contact) closing to round-off of the air held, its constants those of the spec; the oil
+    balance is exact as ever; without the balance no gas.json."""
+    assert not (ran / "gas.json").exists()
+    case = tmp_path / "gas"
+    assert main(["case", "--out", str(case), *SET, "--set",
+                 'thin_film.bubble_gas="balance"', "--set", "run.transits_max=8"]) == 0
+    assert main(["run", str(case), "--quiet"]) == 0
+    gas = json.loads((case / "gas.json").read_text())
+    b = gas["budget_mol"]
+    released = b["released_by_diffusion_mol"] + b["released_at_release_pressure_mol"]
+    assert released > 0
+    assert abs(gas["residual_mol"]) <= 1e-9 * released
+    assert gas["constants"]["release_pressure_Pa"] == 9e4
+    assert gas["constants"]["solubility_ostwald"] == 0.09
+    assert len(gas["per_transit"]["held_mol"]) == len(gas["per_transit"]["time_s"]) >= 1
+    metrics = json.loads((case / "metrics.json").read_text())
+    assert metrics["oil_mass_balance_error"] < 1e-9

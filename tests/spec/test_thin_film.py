@@ -113,3 +113,20 @@ def test_the_thin_film_scene_looks_at_its_oil_twice_a_transit_unless_told():
         .run.writes_per_transit == 8
     assert make_case_spec({}).run.writes_per_transit == 10          # the 3D scenes' default
     assert make_case_spec(None, scene="thin-film").run.writes_per_transit == 2
+
+
+def test_the_gas_balance_takes_its_solubility_and_diffusivity_and_only_it_does():
+    """thin_film.bubble_gas = "balance" reads physics.air_solubility and
+    thin_film.gas_diffusivity; with the release pressure's bubble both are refused when set,
+    by key and value, in one message."""
+    spec = thin(**{"thin_film.bubble_gas": "balance", "physics.air_solubility": 0.08,
+                   "thin_film.gas_diffusivity": 2e-9})
+    assert spec.thin_film.bubble_gas == "balance" and spec.physics.air_solubility == 0.08
+    with pytest.raises(SpecError) as err:
+        thin(**{"physics.air_solubility": 0.08, "thin_film.gas_diffusivity": 2e-9})
+    message = str(err.value)
+    for words in ("physics.air_solubility = 0.08 applies only with thin_film.bubble_gas = "
+                  '"balance"', "thin_film.gas_diffusivity = 2e-09 applies only"):
+        assert words in message
+    with pytest.raises(SpecError, match="bubble_gas"):
+        thin(**{"thin_film.bubble_gas": "ideal"})

@@ -93,3 +93,21 @@ def test_balance_stops_a_march_when_the_outflow_meets_the_supply():
     assert not capped.steady and capped.time == pytest.approx(12 * spec.transit_time, rel=0.01)
     assert balanced.steady and balanced.time < 60 * spec.transit_time
     assert balanced.flux_out / balanced.flux_in == pytest.approx(1.0, abs=0.1)
+
+
+def test_the_gas_balance_of_a_spec_scales_its_diffusivity_with_temperature_and_viscosity():
+    """The balance's constants from the spec: the Ostwald solubility, the ambient and
+    release pressures, and the diffusivity taken from 40 C / 21.6 mPa s to the case's as
+    T / eta^(2/3); none in the release pressure's scene."""
+    from ehlfoam.thinfilm.from_spec import DIFFUSIVITY_REFERENCE, gas_balance, scene_options
+    spec = make_case_spec({"scene": "thin-film"}, **{
+        "thin_film.bubble_gas": "balance", "contact.temperature": 25.0,
+        "physics.cavitation_pressure": 9.5e4})
+    k = gas_balance(spec)
+    eta_ref, t_ref = DIFFUSIVITY_REFERENCE
+    assert k.diffusivity == pytest.approx(1e-9 * (298.15 / t_ref)
+                                          * (eta_ref / spec.oil_viscosity) ** (2 / 3))
+    assert k.diffusivity < 1e-9            # HVI60 is thicker at 25 C
+    assert (k.solubility, k.ambient, k.release) == (0.09, 1.013e5, 9.5e4)
+    assert scene_options(spec).gas
+    assert not scene_options(make_case_spec({"scene": "thin-film"})).gas

@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ehlfoam._io import atomic_write_json
 from ehlfoam.case.bounds import check_extension
 from ehlfoam.case.geometry import META, CaseGeometry, load_geometry, load_spec_of
 from ehlfoam.case.ownership import hold_run_lock
@@ -52,6 +53,8 @@ __all__ = ["STATE_FILE", "run_thin_film_case", "start_of"]
 
 #: the state a thin-film run ends with, in the case folder
 STATE_FILE = "state.npz"
+#: the gas balance's budget a run with thin_film.bubble_gas = "balance" ends with
+GAS_FILE = "gas.json"
 #: lines of the log a failed run's record keeps
 LOG_TAIL_LINES = 20
 #: end_reason of an earlier run whose process was killed (run.monitor's MONITOR_KILLED)
@@ -139,6 +142,9 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
                     on_sample(s, geom)
                 kind = None if extend else thin_film_steady(
                     history, window, spec.run.steady_tolerance, spec.run.transit_length)
+                if kind and not m.gas_settled(spec.run.steady_tolerance,
+                                              spec.thin_film.steady_window):
+                    kind = None       # the bubble's gas still filling or emptying
             if m.steps % m.steps_per_transit == 0:
                 log.transit(m, t0, history[-1] if history else None)
                 write_history(path, history)
@@ -163,6 +169,8 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
             history.append(s)
         save_state(m.solution(reason == "steady"), path / STATE_FILE)
     write_history(path, history)
+    if m.gas is not None:
+        _write_gas(path, m)
     log.end(reason, wall)
     status = {"diverged": "failed", "interrupted": "interrupted"}.get(reason, "finished")
     record = thin_film_record(
@@ -175,6 +183,30 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
             f"{type(failure).__name__}: {failure}".split())[:500])
     write_metrics(path, record)
     return record
+
+
+def _write_gas(path: Path, m: Marcher) -> None:
+    """``DIR/gas.json``: the gas balance's budget over the march [mol, whole contact], what
+    the cavities hold at the end, the budget's residual, and each transit's gas pressure of
+    the largest cavity [Pa, absolute], the held air and the budget so far [mol, whole
+    contact]. A run that goes on from its state takes its cavities' air from it; its budget
+    covers this run (``held_at_start_mol``)."""
+    g = m.gas
+    rows = [(r["time_s"], r["gas_pressure_Pa"] if math.isfinite(r["gas_pressure_Pa"])
+             else None, 2.0 * r["gas_held_mol"]) for r in m.history]
+    atomic_write_json(path / GAS_FILE, {
+        "constants": {"solubility_ostwald": g.k.solubility,
+                      "diffusivity_m2_s": g.k.diffusivity, "temperature_K": g.k.temperature,
+                      "saturation_pressure_Pa": g.k.ambient,
+                      "release_pressure_Pa": g.k.release},
+        "budget_mol": {k: 2.0 * v for k, v in g.budget.items()},
+        "held_mol": 2.0 * g.held(), "held_at_start_mol": 2.0 * g.start,
+        "residual_mol": 2.0 * g.budget_residual(),
+        "largest_cavity": {k: (2.0 * v if k != "pressure_Pa" else v)
+                           for k, v in g.last.items()},
+        "per_transit": {"time_s": [r[0] for r in rows], "pressure_Pa": [r[1] for r in rows],
+                        "held_mol": [r[2] for r in rows],
+                        **{k: [2.0 * r[k] for r in m.history] for k in g.budget}}})
 
 
 def _on_sigterm() -> bool:
@@ -222,7 +254,9 @@ class _Log:
                     f"{fmt(p.get('flooded_width_over_a'))} a, bubble "
                     f"{fmt(p.get('bubble_length_over_a'))} a, {rec['cavity_cells']} cavity "
                     f"cells, {rec['cells_opened_to_gas']} opened to gas, "
-                    f"{rec['cells_opened_dry']} ran dry")
+                    f"{rec['cells_opened_dry']} ran dry"
+                    + (f", gas {rec['gas_pressure_Pa'] / 1e3:.2f} kPa, "
+                       f"{2.0 * rec['gas_held_mol']:.3g} mol" if "gas_held_mol" in rec else ""))
 
     def failure(self, err: BaseException) -> list[str]:
         """Log the traceback; the log's last lines."""

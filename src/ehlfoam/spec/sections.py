@@ -189,7 +189,9 @@ class Physics(BaseModel):
         0.09, ge=0.0, le=1.0,
         description="Bunsen coefficient of air in the oil: volumes of air (at ambient "
                     "pressure) that a volume of saturated oil holds dissolved (about 0.09 for "
-                    "mineral oils). The run reports its gas release against it.")
+                    "mineral oils). The run reports its gas release against it; the "
+                    "thin-film scene's gas balance (thin_film.bubble_gas = \"balance\") takes "
+                    "it as Henry's law's Ostwald coefficient, C = s p / (R T).")
 
 
 @dataclass(frozen=True)

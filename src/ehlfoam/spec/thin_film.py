@@ -50,8 +50,7 @@ THREE_D_ONLY: dict[str, tuple[tuple[str, ...], str]] = {
                "the model's supply covers the whole track and it seeds no gas"),
     "physics": (("oil_density", "air_density", "air_viscosity", "interface_compression",
                  "isotropic_compression", "interface_schemes", "wall_slip_length",
-                 "oil_bulk_modulus", "gas_release_rate", "gas_dissolution_rate",
-                 "air_solubility"),
+                 "oil_bulk_modulus", "gas_release_rate", "gas_dissolution_rate"),
                 "the gap-averaged model has no inertia, no air flow, no interface numerics "
                 "and no gas-release kinetics"),
     "mesh": (("n_layers", "size_rim", "size_far", "wall_grading", "wall_cell",
@@ -108,6 +107,25 @@ class ThinFilm(BaseModel):
                     "mean outflow within run.steady_tolerance of the supply, and the oil and "
                     "the menisci as run.steady_tolerance says. The region fills slowly, over "
                     "tens of transits, which one transit's reading takes for a balance.")
+
+    bubble_gas: Literal["release-pressure", "balance"] = Field(
+        "release-pressure",
+        description='The gas of the bubble behind the contact (a cavity the flooded region '
+                    'encloses): "release-pressure", at physics.cavitation_pressure whatever '
+                    'its amount; "balance", the air it holds at its volume and the oil\'s '
+                    'temperature (ideal gas), released from the oil saturated at '
+                    'physics.ambient_pressure (Henry\'s law, physics.air_solubility) and '
+                    'dissolved back at the rates of diffusion across its menisci and films, '
+                    'lost to the outer air where it reaches it; its menisci at '
+                    'Young-Laplace\'s pressure below it. physics.cavitation_pressure is then '
+                    'the release pressure: a new cavity opens below it, and no gas is ever '
+                    'below it.')
+    gas_diffusivity: float = Field(
+        1e-9, gt=0.0, le=1e-6,
+        description='With bubble_gas = "balance": the diffusivity of air in the oil at '
+                    '40 C and 21.6 mPa s (HVI60), taken to the case\'s temperature T and '
+                    'viscosity eta as T / eta^(2/3) (Hiss and Cussler).',
+        json_schema_extra={"unit": "m2/s"})
 
     @field_validator("receding_meniscus")
     @classmethod
@@ -179,6 +197,14 @@ def check_thin_film(spec: CaseSpec) -> None:
         problems.append(f"physics.cavitation_pressure = {p.cavitation_pressure:g} Pa must be "
                         f"below physics.ambient_pressure = {p.ambient_pressure:g} Pa for scene "
                         "= \"thin-film\" (the oil gives up gas below ambient)")
+    if tf.bubble_gas != "balance":
+        for table, name in (("physics", "air_solubility"), ("thin_film", "gas_diffusivity")):
+            section = getattr(spec, table)
+            value, default = getattr(section, name), _default(type(section), name)
+            if value != default:
+                problems.append(f'{table}.{name} = {value!r} applies only with '
+                                f'thin_film.bubble_gas = "balance" (the bubble\'s gas '
+                                f'balance; leave it at {default!r})')
     cell = thin_film_cell(spec)
     span = min(d.side / 2, (d.upstream + d.downstream) / 8)
     where = "thin_film.cell" if tf.cell is not None else \

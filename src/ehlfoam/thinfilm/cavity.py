@@ -20,8 +20,10 @@ gives its gas to the air); a flooded cell below p_cav opens (its oil is still al
 film content) and the pressure is solved again, until none is below. A cell opened so
 beside the outer air joins it: the meniscus moves in. A cavity that grows to reach the
 outer air becomes outer air: the wake opens (state II). Gas release kinetics and the
-dissolved air's budget are not modelled: the gas comes out the moment the pressure falls
-below p_cav, as much as the oil's room needs (docs/models/thin-film.md#the-outlet).
+dissolved air's budget are not modelled here: the gas comes out the moment the pressure falls
+below p_cav, as much as the oil's room needs (docs/models/thin-film.md#the-outlet), unless
+the problem has a gas balance (:mod:`ehlfoam.thinfilm.gas`): then each cavity's pressure is
+that of the air it holds, and its menisci are Young-Laplace's below it.
 """
 
 from __future__ import annotations

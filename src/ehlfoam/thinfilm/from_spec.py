@@ -31,17 +31,22 @@ from ehlfoam._io import atomic_write_json
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.cycle import rig_layers
 from ehlfoam.spec.thin_film import thin_film_cell
+from ehlfoam.thinfilm.gas import GasBalance
 from ehlfoam.thinfilm.march import solve_thin_film
 from ehlfoam.thinfilm.problem import ThinFilmProblem
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import save_state
 
-__all__ = ["CAVITATING_SCENES", "RegionOptions", "cavitation_gauge", "march",
+__all__ = ["CAVITATING_SCENES", "RegionOptions", "cavitation_gauge", "gas_balance", "march",
            "problem_from_spec", "scene_options", "write_region"]
 
 #: The scenes whose oil gives up gas below physics.cavitation_pressure: their thin-film
 #: problems have the outlet model.
 CAVITATING_SCENES = ("cavitating", "gas-release", "thin-film")
+
+#: the oil viscosity [Pa s] and temperature [K] at which thin_film.gas_diffusivity is given
+#: (HVI60 at 40 C)
+DIFFUSIVITY_REFERENCE = (21.6e-3, 313.15)
 
 #: the files :func:`write_region` writes into its folder
 STATE_FILE, SUMMARY_FILE = "state.npz", "summary.json"
@@ -65,6 +70,8 @@ class RegionOptions:
             "cell" (at that cell's centre).
         cavitation: the outlet model: gas at the spec's cavitation pressure where the oil
             would fall below it; None: the spec's scene says (:data:`CAVITATING_SCENES`).
+        gas: the cavities' gas as a balance (:func:`gas_balance`) rather than at the
+            cavitation pressure (with the outlet model only).
     """
 
     cell: float = 0.2
@@ -75,6 +82,7 @@ class RegionOptions:
     normal_length: float | None = 0.3
     meniscus_position: Literal["sub-cell", "cell"] = "sub-cell"
     cavitation: bool | None = None
+    gas: bool = False
 
 
 def scene_options(spec: CaseSpec) -> RegionOptions:
@@ -85,7 +93,20 @@ def scene_options(spec: CaseSpec) -> RegionOptions:
     return RegionOptions(cell=thin_film_cell(spec), domain=(-d.upstream, d.downstream, d.side),
                          film_factor=tf.film_factor, receding=tf.receding_meniscus,
                          advancing_angle=tf.advancing_angle, normal_length=tf.normal_length,
-                         cavitation=True)
+                         cavitation=True, gas=tf.bubble_gas == "balance")
+
+
+def gas_balance(spec: CaseSpec) -> GasBalance:
+    """The gas balance's constants of a case spec: physics.air_solubility (Ostwald),
+    thin_film.gas_diffusivity taken to the case's temperature T and oil viscosity eta as
+    T / eta^(2/3) from :data:`DIFFUSIVITY_REFERENCE`, the ambient pressure (at which the oil
+    is saturated) and the cavitation pressure as the release pressure."""
+    eta_ref, t_ref = DIFFUSIVITY_REFERENCE
+    t = spec.temperature_k
+    d = spec.thin_film.gas_diffusivity * (t / t_ref) * (eta_ref / spec.oil_viscosity) ** (2 / 3)
+    p = spec.physics
+    return GasBalance(solubility=p.air_solubility, diffusivity=d, temperature=t,
+                      ambient=p.ambient_pressure, release=p.cavitation_pressure)
 
 
 def cavitation_gauge(spec: CaseSpec) -> float:
@@ -135,7 +156,8 @@ def problem_from_spec(spec: CaseSpec, gap: Callable[[np.ndarray, np.ndarray], np
         receding_meniscus=options.receding,
         normal_length=None if options.normal_length is None else options.normal_length * a,
         advancing_angle=options.advancing_angle, meniscus_position=options.meniscus_position,
-        cavitation_pressure=p_cav)
+        cavitation_pressure=p_cav,
+        gas=gas_balance(spec) if options.gas and p_cav is not None else None)
 
 
 def _check_grid(options: RegionOptions, island: float) -> None:

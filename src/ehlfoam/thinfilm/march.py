@@ -46,6 +46,8 @@ With a cavitation pressure (``cavitation_pressure``, gauge) the model has an out
 flooded cell whose pressure would fall below it opens to gas, the gas the flooded region
 encloses (a cavity, the bubble behind the contact) is at it, and the walls carry the oil of
 a cavity's cells, their film content, on at u, all of it (:mod:`ehlfoam.thinfilm.cavity`).
+With a gas balance (``gas``) each cavity's pressure is that of the air it holds, exchanged
+with the oil step by step (:mod:`ehlfoam.thinfilm.gas`, :attr:`Marcher.gas`).
 
 This is the mass-conserving cavitation model of lubrication (Elrod-Adams; Jakobsson,
 Floberg and Olsson's conditions) with two changes that make it a model of this flow: the
@@ -70,6 +72,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ehlfoam.thinfilm.gas import CavityGas
 from ehlfoam.thinfilm.operators import Operators
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 from ehlfoam.thinfilm.solution import ThinFilmSolution, connected_region, oil_fraction_on
@@ -117,6 +120,11 @@ class Marcher:
         self.steps = 0
         self.history: list[dict] = []
         self._out = self._dry = self._cavitated = 0.0
+        self.gas = None if prob.gas is None else CavityGas(prob.gas, h, grid.hx, grid.hy, d, u)
+        if self.gas is not None and start is not None and start.gas is not None \
+                and start.gas.shape == h.shape:     # the air of a state on this grid
+            self.gas.n = np.where(self.cavity(), start.gas, 0.0)
+            self.gas.start = self.gas.held()
 
     def set_supply(self, layers: tuple[np.ndarray, np.ndarray]) -> None:
         """From the next step on, the walls bring in the lateral profiles ``layers`` (disc,
@@ -139,10 +147,19 @@ class Marcher:
     def step(self) -> None:
         """One step; a transit's record is added to :attr:`history` after each
         ``steps_per_transit`` steps."""
-        s = self.ops.step(self.flooded, self.c, self.dt)
+        gas = self.gas
+        c_old, flooded_old = self.c, self.flooded
+        s = self.ops.step(self.flooded, self.c, self.dt,
+                          None if gas is None else
+                          lambda cav: gas.pressure(cav, c_old) - gas.k.ambient)
         self.c = self.c + s.dc
         self.flooded = ((self.c >= self.h * (1.0 - 1e-9)) & ~s.opened & ~s.cavitated
                         & ~self.grid.island)
+        if gas is not None:
+            new = self.cavity()
+            outer = ~self.flooded & ~self.grid.island & ~new
+            gas.advance(s.cavity, c_old, new, outer, self.c,
+                        flooded_old & ~s.opened & ~s.cavitated, self.dt)
         self.p = s.p
         self.steps += 1
         self.oil_in += self.q_in * self.dt
@@ -171,6 +188,10 @@ class Marcher:
                "cells_opened_dry": int(self._dry),
                "cells_opened_to_gas": int(self._cavitated),
                "cavity_cells": int(self.cavity().sum())}
+        if self.gas is not None:
+            rec.update(gas_held_mol=self.gas.held(),
+                       gas_pressure_Pa=self.gas.last.get("pressure_Pa", float("nan")),
+                       **self.gas.budget)
         self._out = self._dry = self._cavitated = 0.0
         return rec
 
@@ -187,7 +208,20 @@ class Marcher:
             return False
         change = abs(h[-1]["oil_m3"] - h[-1 - window]["oil_m3"])
         out = np.mean([r["outflow_over_supply"] for r in h[-window:]])
-        return change <= tolerance * h[-1]["oil_m3"] and abs(out - 1.0) <= tolerance
+        return (change <= tolerance * h[-1]["oil_m3"] and abs(out - 1.0) <= tolerance
+                and self.gas_settled(tolerance, window))
+
+    def gas_settled(self, tolerance: float, window: int) -> bool:
+        """With a gas balance: over the last ``window`` transits the air the cavities hold
+        changed by less than ``tolerance`` of itself (or they hold none); True without one.
+        The gas fills a bubble over tens of transits, slower than the oil settles."""
+        h = self.history
+        if self.gas is None:
+            return True
+        if len(h) <= window:
+            return False
+        now, then = h[-1]["gas_held_mol"], h[-1 - window]["gas_held_mol"]
+        return abs(now - then) <= tolerance * max(now, then)
 
     def mass_balance_error(self) -> float:
         """The oil gained less what came in and went out since the start, over what came in
@@ -208,7 +242,10 @@ class Marcher:
             mass_balance_error=self.mass_balance_error(),
             fill=np.where(self.flooded, 0.0, self.ops.fill(self.c, cavity))
             if self.ops.sub_cell else None,
-            cavity=cavity, cavitation_pressure=self.prob.cavitation_pressure)
+            cavity=cavity, cavitation_pressure=self.prob.cavitation_pressure,
+            gas=None if self.gas is None else self.gas.n.copy(),
+            gas_pressure=None if self.gas is None else
+            self.gas.pressure(cavity, self.c) - self.gas.k.ambient)
 
 
 def solve_thin_film(prob: ThinFilmProblem, transits_max: float = 60.0,

@@ -5,6 +5,7 @@ cavities at the cavitation pressure: :mod:`ehlfoam.thinfilm.cavity`)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -102,7 +103,8 @@ class Operators:
         return cavities(flooded, self.island, self.closed_side)
 
     def menisci(self, flooded: np.ndarray, c: np.ndarray,
-                cavity: np.ndarray | None = None) -> "_Faces":
+                cavity: np.ndarray | None = None,
+                gas: np.ndarray | None = None) -> "_Faces":
         """Each face between a flooded cell and an open one: the flooded cell's conductance
         to the meniscus and the meniscus's pressure, for x faces and y faces. The meniscus
         sits theta cells from the flooded cell's centre, at the gap there (linear between
@@ -110,7 +112,9 @@ class Operators:
         fill; cell, theta = 1 (the open cell's centre). Its pressure: Young-Laplace's,
         times the dynamic menisci's factor (``pull_factor``), but no lower than the
         cavitation pressure; a cavity's boundary (``cavity``: the open cells the region
-        encloses) is at the cavitation pressure."""
+        encloses) is at the cavitation pressure, or, with ``gas`` (every cavity cell's gas
+        pressure, gauge [Pa]: the gas balance, :mod:`ehlfoam.thinfilm.gas`), a meniscus
+        like the outer air's, Young-Laplace's below that gas pressure, floored alike."""
         if cavity is None:
             cavity = np.zeros_like(flooded)
         factor = np.broadcast_to(self.pull_factor(flooded), flooded.shape)
@@ -130,8 +134,12 @@ class Operators:
             suction = np.where(hi_open, factor[hi], factor[lo]) * self.young_laplace / safe
             p_m = np.where(h_m > 0, -suction, 0.0)
             if self.p_cav is not None:
-                p_m = np.where(np.where(hi_open, cavity[hi], cavity[lo]), self.p_cav,
-                               np.maximum(p_m, self.p_cav))
+                in_cavity = np.where(hi_open, cavity[hi], cavity[lo])
+                if gas is None:
+                    p_m = np.where(in_cavity, self.p_cav, np.maximum(p_m, self.p_cav))
+                else:
+                    p_gas = np.nan_to_num(np.where(hi_open, gas[hi], gas[lo]))
+                    p_m = np.maximum(np.where(in_cavity, p_gas + p_m, p_m), self.p_cav)
             per_axis[axis] = (g / th, p_m, h_m)
         (gx, px, hx), (gy, py, _) = per_axis[1], per_axis[0]
         return _Faces(gx=gx, gy=gy, px=px, py=py, hx=hx)
@@ -182,18 +190,22 @@ class Operators:
         p[flooded] = spsolve(A, rhs, permc_spec="MMD_AT_PLUS_A")
         return p
 
-    def step(self, flooded: np.ndarray, c: np.ndarray, dt: float) -> "Step":
+    def step(self, flooded: np.ndarray, c: np.ndarray, dt: float,
+             gas: Callable[[np.ndarray], np.ndarray] | None = None) -> "Step":
         """One step (:class:`Step`). An open cell gives no more than it holds: the flooded
         cells drawing on it get less and run short of a full gap (air comes in: they open
         next step). A flooded cell that would run dry within the step opens now, and one
         whose pressure falls below the cavitation pressure opens to gas now (its oil stays:
         Elrod-Adams's complementarity, :mod:`ehlfoam.thinfilm.cavity`); p is solved again
-        until neither happens."""
+        until neither happens. ``gas``: the cavities' gas pressures (gauge [Pa] on their
+        cells) for a set of cavity cells, where a gas balance sets them
+        (:mod:`ehlfoam.thinfilm.gas`); None: at the cavitation pressure."""
         opened = np.zeros_like(flooded)
         cavitated = np.zeros_like(flooded)
         for _ in range(1000):
             cavity = self.cavities(flooded)
-            faces = self.menisci(flooded, c, cavity)
+            faces = self.menisci(flooded, c, cavity,
+                                 None if gas is None or not cavity.any() else gas(cavity))
             p = self.pressure(flooded, c, dt, faces)
             if self.p_cav is not None:
                 low = flooded & (p < self.p_cav - 1e-9 * abs(self.p_cav))

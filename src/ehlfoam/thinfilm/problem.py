@@ -10,6 +10,8 @@ from typing import Literal
 
 import numpy as np
 
+from ehlfoam.thinfilm.gas import GasBalance
+
 #: A row whose supply layers are below this share of the profile's largest counts as dry
 #: walls coming in (the advancing angle applies there).
 DRY_SHARE = 0.01
@@ -78,6 +80,12 @@ class ThinFilmProblem:
             tension (no outlet model). With it, a flooded cell whose pressure would fall
             below it opens to gas, the gas the flooded region encloses is at it, and a
             meniscus's pressure never falls below it (:mod:`ehlfoam.thinfilm.cavity`).
+        gas: with a cavitation pressure, the cavities' gas as a balance (its constants,
+            :class:`~ehlfoam.thinfilm.gas.GasBalance`): each cavity's pressure from the air
+            it holds, released from and dissolved into the oil at the rates of diffusion,
+            its menisci at Young-Laplace's pressure below it; the cavitation pressure is
+            then the release pressure, below which the oil gives up gas at once. None: the
+            cavities at the cavitation pressure.
     """
 
     gap: Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -100,6 +108,7 @@ class ThinFilmProblem:
     meniscus_position: Literal["sub-cell", "cell"] = "sub-cell"
     cavitation_pressure: float | None = None
     supply_layers: tuple[np.ndarray, np.ndarray] | None = field(default=None, compare=False)
+    gas: GasBalance | None = None
 
     def __post_init__(self) -> None:
         span = min(self.y_max / 2, (self.x_range[1] - self.x_range[0]) / 8)
@@ -136,6 +145,8 @@ class ThinFilmProblem:
                                     or (np.isfinite(self.cavitation_pressure)
                                         and self.cavitation_pressure < 0),
                                     "None or a finite gauge pressure < 0 Pa (below ambient)"),
+            "gas": (self.gas, self.gas is None or self.cavitation_pressure is not None,
+                    "None without a cavitation_pressure (the balance is the cavities' gas)"),
         }
         for name, (value, ok, valid) in checks.items():
             if not ok:

@@ -23,7 +23,9 @@ class ThinFilmSolution:
     went out, over what came in); with sub-cell menisci, ``fill``: how far into each open
     cell its meniscus reaches (0-1; in a cavity its film content over its gap); with the
     outlet model, ``cavity``: the open cells whose gas the region encloses, at the gauge
-    ``cavitation_pressure`` [Pa] (:mod:`ehlfoam.thinfilm.cavity`)."""
+    ``cavitation_pressure`` [Pa] (:mod:`ehlfoam.thinfilm.cavity`); with the gas balance
+    (:mod:`ehlfoam.thinfilm.gas`), ``gas``: the air each cavity cell holds [mol, half
+    domain] and ``gas_pressure``: its cavity's gas pressure [Pa, gauge; NaN elsewhere]."""
 
     grid: Grid
     p: np.ndarray
@@ -40,6 +42,8 @@ class ThinFilmSolution:
     fill: np.ndarray | None = None
     cavity: np.ndarray | None = None
     cavitation_pressure: float | None = None
+    gas: np.ndarray | None = None
+    gas_pressure: np.ndarray | None = None
 
     def region(self) -> np.ndarray:
         """The flooded cells connected to the island: the flooded region, bool (ny, nx)."""
@@ -77,11 +81,13 @@ class ThinFilmSolution:
 
     def gauge_pressure(self) -> np.ndarray:
         """The pressure of every cell [Pa, gauge; NaN in the island]: the solved one in the
-        flooded cells, the cavitation pressure in the cavities, 0 (ambient) in the outer
-        air."""
+        flooded cells, the cavitation pressure in the cavities (their gas's, with the gas
+        balance), 0 (ambient) in the outer air."""
         gas = np.zeros(self.flooded.shape)
         if self.cavity is not None and self.cavitation_pressure is not None:
-            gas = np.where(self.cavity, self.cavitation_pressure, 0.0)
+            at = self.cavitation_pressure if self.gas_pressure is None else \
+                np.nan_to_num(self.gas_pressure, nan=self.cavitation_pressure)
+            gas = np.where(self.cavity, at, 0.0)
         p = np.where(self.flooded, np.nan_to_num(self.p), gas)
         return np.where(self.grid.island, np.nan, p)
 

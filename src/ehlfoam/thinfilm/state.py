@@ -20,7 +20,8 @@ from ehlfoam.thinfilm.solution import ThinFilmSolution
 def save_state(sol: ThinFilmSolution, path: str | Path) -> None:
     """Write the cell centres x, y [m], gaps h [m], ``flooded``, oil content c [m], pressure
     p [Pa], the menisci's fills, the time [s] and steps marched and, with the outlet model,
-    the cavities' cells and the cavitation pressure [Pa, gauge] of ``sol`` to ``path``
+    the cavities' cells and the cavitation pressure [Pa, gauge] (with the gas balance the
+    air its cavity cells hold [mol] and their gas pressure [Pa, gauge]) of ``sol`` to ``path``
     (.npz), atomically."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -28,6 +29,10 @@ def save_state(sol: ThinFilmSolution, path: str | Path) -> None:
     extra = {} if sol.cavity is None else {"cavity": sol.cavity}
     if sol.cavitation_pressure is not None:
         extra["cavitation_pressure"] = np.float64(sol.cavitation_pressure)
+    if sol.gas is not None:
+        extra["gas_mol"] = sol.gas
+    if sol.gas_pressure is not None:
+        extra["gas_pressure"] = sol.gas_pressure
     atomic_write(path, lambda fh: np.savez_compressed(
         fh, x=sol.grid.x, y=sol.grid.y, h=sol.grid.h, flooded=sol.flooded,
         content=sol.content, p=sol.p, fill=fill, time_s=np.float64(sol.time),
@@ -51,4 +56,6 @@ def load_state(path: str | Path) -> ThinFilmSolution:
             fill=d["fill"] if "fill" in d else None,
             cavity=d["cavity"] if "cavity" in d else None,
             cavitation_pressure=float(d["cavitation_pressure"])
-            if "cavitation_pressure" in d else None)
+            if "cavitation_pressure" in d else None,
+            gas=d["gas_mol"] if "gas_mol" in d else None,
+            gas_pressure=d["gas_pressure"] if "gas_pressure" in d else None)
