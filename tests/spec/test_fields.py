@@ -13,10 +13,10 @@ from ehlfoam.spec import CaseSpec, make_case_spec
 from ehlfoam.spec.mesh import REFINE_KINDS
 from tests.test_citations import REMOVED
 
-#: The units a field may state: SI (volumes of oil in m3), the Hertzian radius a for in-plane
+#: The units a field may state: SI (volumes of oil in m3, a diffusivity in m2/s), the Hertzian radius a for in-plane
 #: lengths, degrees, C.
 UNITS = {"a", "deg", "C", "m", "s", "N", "Pa", "Pa s", "kg/m3", "m/s", "N/m", "1/s", "1/Pa",
-         "1/(Pa s)", "m3"}
+         "1/(Pa s)", "m3", "m2/s"}
 
 
 def _models(root: type[BaseModel]) -> list[type[BaseModel]]:
