@@ -27,7 +27,9 @@ import numpy as np
 from scipy.ndimage import minimum_filter
 
 from ehlfoam.contact.elastic import Deformation, hertz_pressure
-from ehlfoam.contact.lubricant import PressureLaws, coefficients, coefficients_parallel
+from ehlfoam.contact.inlet import march_theta, meniscus_mask
+from ehlfoam.contact.lubricant import (PressureLaws, coefficients, coefficients_parallel,
+                                       limit_viscosity_step)
 from ehlfoam.contact.reynolds import relax, relax_parallel, residual, residual_parallel
 from ehlfoam.contact.threads import PARALLEL_MIN_POINTS, numba_threads, solve_threads
 from ehlfoam.contact.transfer import (prolong_bilinear, prolong_cubic, restrict_full_weighting,
@@ -141,6 +143,11 @@ class Problem:
     neumann_outlet: bool = False
     moes_M: float = 100.0
     moes_L: float = 0.0
+    #: starved inlet (:mod:`ehlfoam.contact.inlet`): the oil layer carried in at x_min
+    #: (units a^2/R; film content upstream of X = theta_x_max), or the meniscus X (units a)
+    inlet_layer: float | None = None
+    inlet_meniscus_x: float | None = None
+    theta_x_max: float = 0.0
 
     @property
     def params(self) -> np.ndarray:
@@ -172,6 +179,8 @@ class Level:
         self._coef = [np.empty((ny, nx)) for _ in range(5)]
         self._W_of: np.ndarray | None = None  # the pressure whose deformation is self._W
         self._W = np.zeros((ny, nx))
+        self.theta = np.ones((ny, nx))  # film content (starved inlet), 1: a full gap
+        self.dry = np.zeros((ny, nx), dtype=bool)  # held at P = p_floor (starved inlet)
 
     def load(self, P: np.ndarray) -> float:
         return self.h * self.h * float(P.sum())
@@ -203,47 +212,38 @@ class Level:
         H, rho, _, eps, _, _ = self.coefficients(P, H0, prob, H)
         r = np.zeros_like(P)
         wedge = np.zeros_like(P)
-        self._residual(P, rho * H, eps, self.f if f is None else f, self.h, self.h, r, wedge)
+        f = self.f if f is None else f
         if not raw:
-            r[(P <= prob.p_floor) & (r > 0.0)] = 0.0
+            self.update_inlet(P, H, rho, eps, f, prob)
+        rhoH = rho * H * self.theta if prob.inlet_layer is not None else rho * H
+        self._residual(P, rhoH, eps, f, self.h, self.h, r, wedge)
+        if not raw:
+            r[((P <= prob.p_floor) & (r > 0.0)) | self.dry] = 0.0
         return r, wedge, H
+
+    def update_inlet(self, P, H, rho, eps, f, prob: Problem) -> None:
+        """The starved inlet's film content and dry points at pressure P (none: no-op)."""
+        if prob.inlet_layer is not None:
+            march_theta(P, rho * H, eps, f, self.h, prob.inlet_layer,
+                        int(np.searchsorted(self.x, prob.theta_x_max)), prob.p_floor,
+                        self.theta, self.dry)
+        elif prob.inlet_meniscus_x is not None:
+            self.dry = meniscus_mask(self.x, self.ny, prob.inlet_meniscus_x)
 
     def relax(self, H0: float, prob: Problem, opt: SolverOptions) -> None:
         self.sweeps += 1
         H, rho, drho, eps, deps, ln_eta = self.coefficients(self.P, H0, prob)
         P_old = self.P.copy() if opt.max_ln_eta_step > 0.0 else None
+        self.update_inlet(self.P, H, rho, eps, self.f, prob)
+        if prob.inlet_layer is not None:  # the wedge d(rho theta H)/dX
+            rho, drho = rho * self.theta, drho * self.theta
         self._relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
                     opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet,
-                    self.work, deps, True, opt.zebra)
+                    self.work, deps, self.dry, True, opt.zebra)
         if P_old is not None:
             limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step, ln_eta)
             if prob.neumann_outlet:
                 self.P[:, -1] = self.P[:, -2]
-
-
-def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
-                         max_step: float, ln_eta_old: np.ndarray | None = None) -> None:
-    """Damp a relaxation sweep where it would change the viscosity by more than a factor
-    e^max_step; updates the dimensionless pressure ``P`` in place (``ln_eta_old``: the laws'
-    ln(eta / eta0) at ``P_old`` where known).
-
-    The line systems hold eps = rho H^3 / (eta lambda) frozen, so where the pressure-viscosity
-    product alpha pH is large (Moes L >= 20) a step of a few tenths in P changes eta by orders
-    of magnitude and the next sweep overshoots: the pressure spike runs away to
-    exp(alpha p) overflow. Scaling the step at such points to |d ln(eta)| = max_step keeps the
-    fixed point (the limiter is inactive once the steps are small) and only slows the first
-    sweeps of a large-L solve.
-    """
-    dP_max = float(np.max(np.abs(P - P_old)))
-    if dP_max * laws.max_dln_eta_dP(max(float(P.max()), float(P_old.max()))) <= max_step:
-        return  # no point can have changed ln(eta) by more than max_step
-    if ln_eta_old is None:
-        ln_eta_old = laws.ln_eta(P_old)
-    d_ln_eta = np.abs(laws.ln_eta(P) - ln_eta_old)
-    big = d_ln_eta > max_step
-    if np.any(big):
-        dP = P[big] - P_old[big]
-        P[big] = P_old[big] + dP * (max_step / d_ln_eta[big])
 
 
 @dataclass
@@ -268,6 +268,8 @@ class MGResult:
     fmg_hc: list = field(default_factory=list)
     #: relaxation sweeps of all levels in units of one finest-level sweep
     work_units: float = 0.0
+    #: film content of the finest level (starved inlet; 1 elsewhere), None if not kept
+    theta: np.ndarray | None = None
 
 
 class MultigridSolver:
@@ -300,6 +302,8 @@ class MultigridSolver:
         else:
             P[:, -1] = 0.0
         np.maximum(P, self.prob.p_floor, out=P)
+        if self.prob.inlet_meniscus_x is not None:
+            P[meniscus_mask(lv.x, lv.ny, self.prob.inlet_meniscus_x)] = self.prob.p_floor
 
     def _solve_coarsest(self) -> None:
         lv = self.levels[0]
@@ -322,6 +326,7 @@ class MultigridSolver:
         r, _, H = lv.residual(lv.P, self.H0, prob)
         P_hat = restrict_pressure(lv.P, prob.p_floor)
         co.P = P_hat.copy()
+        co.theta = lv.theta[::2, ::2].copy()  # the coarse operator of P_hat: the fine theta
         # film FAS correction: the coarse film of P_hat is the fine film at the coarse points
         H_hat = H[::2, ::2]
         co.tauW = H_hat - self.H0 - co.rigid - co.deform(P_hat)
@@ -488,4 +493,4 @@ class MultigridSolver:
                         work_units=self.work_units(),
                         converged=converged, residual=res, load_error=load_err, cycles=cycles,
                         history=history, wall_s=time.perf_counter() - t0, failure=failure,
-                        stalled_at=stalled_at, fmg_hc=fmg_hc)
+                        stalled_at=stalled_at, fmg_hc=fmg_hc, theta=lv.theta.copy())
