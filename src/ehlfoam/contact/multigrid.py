@@ -181,6 +181,7 @@ class Level:
         self._W = np.zeros((ny, nx))
         self.theta = np.ones((ny, nx))  # film content (starved inlet), 1: a full gap
         self.dry = np.zeros((ny, nx), dtype=bool)  # held at P = p_floor (starved inlet)
+        self.march = True  # theta marched here; a coarse level of a cycle takes the fine's
 
     def load(self, P: np.ndarray) -> float:
         return self.h * self.h * float(P.sum())
@@ -223,7 +224,7 @@ class Level:
 
     def update_inlet(self, P, H, rho, eps, f, prob: Problem) -> None:
         """The starved inlet's film content and dry points at pressure P (none: no-op)."""
-        if prob.inlet_layer is not None:
+        if prob.inlet_layer is not None and self.march:
             march_theta(P, rho * H, eps, f, self.h, prob.inlet_layer,
                         int(np.searchsorted(self.x, prob.theta_x_max)), prob.p_floor,
                         self.theta, self.dry)
@@ -326,7 +327,9 @@ class MultigridSolver:
         r, _, H = lv.residual(lv.P, self.H0, prob)
         P_hat = restrict_pressure(lv.P, prob.p_floor)
         co.P = P_hat.copy()
-        co.theta = lv.theta[::2, ::2].copy()  # the coarse operator of P_hat: the fine theta
+        # the fine film content, fixed on the coarse level (a consistent FAS operator)
+        co.theta, co.march = lv.theta[::2, ::2].copy(), False
+        co.dry = co.theta < 1.0
         # film FAS correction: the coarse film of P_hat is the fine film at the coarse points
         H_hat = H[::2, ::2]
         co.tauW = H_hat - self.H0 - co.rigid - co.deform(P_hat)
