@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["march_theta", "meniscus_mask", "meniscus_x_on_centreline"]
+__all__ = ["march_theta", "meniscus_mask", "meniscus_x_on_centreline", "update_inlet"]
 
 
 @njit(cache=True)
@@ -105,3 +105,16 @@ def meniscus_x_on_centreline(x: np.ndarray, y: np.ndarray, P: np.ndarray,
     while k > 0 and theta[j, k - 1] >= 1.0:
         k -= 1
     return float(x[k])
+
+
+def update_inlet(level, P, H, rho, eps, f, prob) -> None:
+    """A multigrid level's film content ``level.theta`` and dry points ``level.dry`` at
+    pressure P (film H, density rho, Poiseuille coefficient eps, right-hand side f) for the
+    problem's starved inlet; nothing for a flooded one, and the layer's theta only where the
+    level marches (``level.march``; a coarse level of a cycle may keep the fine's)."""
+    if prob.inlet_layer is not None and level.march:
+        march_theta(P, rho * H, eps, f, level.h, prob.inlet_layer,
+                    int(np.searchsorted(level.x, prob.theta_x_max)), prob.p_floor,
+                    level.theta, level.dry)
+    elif prob.inlet_meniscus_x is not None:
+        level.dry = meniscus_mask(level.x, level.ny, prob.inlet_meniscus_x)

@@ -13,8 +13,8 @@ FAS correction of the film (fine deformation minus coarse deformation of the inj
 pressure) and of the load. H0 is relaxed against the load on the coarsest level, whose
 problem is solved (rounds of sweeps and H0 steps). Full multigrid (FMG) start from a
 Hertzian pressure on the coarsest level, each finer level cycled to its own discretisation
-error; the finest level until its film has settled (see :class:`SolverOptions`). Grid
-transfers: :mod:`ehlfoam.contact.transfer`.
+error; the finest level until its film has settled (see :class:`SolverOptions`). Transfers:
+:mod:`ehlfoam.contact.transfer`; a starved inlet's film content: :mod:`ehlfoam.contact.inlet`.
 """
 
 from __future__ import annotations
@@ -27,9 +27,9 @@ import numpy as np
 from scipy.ndimage import minimum_filter
 
 from ehlfoam.contact.elastic import Deformation, hertz_pressure
-from ehlfoam.contact.inlet import march_theta, meniscus_mask
-from ehlfoam.contact.lubricant import (PressureLaws, coefficients, coefficients_parallel,
-                                       limit_viscosity_step)
+from ehlfoam.contact.inlet import meniscus_mask, update_inlet
+from ehlfoam.contact.lubricant import PressureLaws, coefficients, coefficients_parallel
+from ehlfoam.contact.lubricant import limit_viscosity_step
 from ehlfoam.contact.reynolds import relax, relax_parallel, residual, residual_parallel
 from ehlfoam.contact.threads import PARALLEL_MIN_POINTS, numba_threads, solve_threads
 from ehlfoam.contact.transfer import (prolong_bilinear, prolong_cubic, restrict_full_weighting,
@@ -90,6 +90,8 @@ class SolverOptions:
         before; the solve then goes on with :meth:`stalled` options (once).
     workers: threads of the solve (scipy.fft and the numba kernels); None: the caller's
         numba thread count (:func:`solve_threads`).
+    fixed_coarse_theta: a starved inlet's coarse levels take the fine film content fixed
+        instead of marching their own (the stalled options set it).
     """
 
     nu1: int = 2
@@ -123,12 +125,14 @@ class SolverOptions:
     stall_ratio: float = 0.7
     workers: int | None = None
     zebra: bool = True
+    fixed_coarse_theta: bool = False
 
     def stalled(self) -> "SolverOptions":
         """Options for the rest of a stalled solve (large L: a limit cycle between the pressure
         spike's side lobes and the coarse-grid correction): half the distributive-Jacobi
         under-relaxation, five more fine sweeps after each coarse-grid correction, and the
-        correction itself held to the viscosity-step limit."""
+        correction itself held to the viscosity-step limit. (A starved inlet's solve is watched
+        for a second stall, which fixes the coarse film content: :meth:`_solve`.)"""
         return replace(self, w_ja=0.5 * self.w_ja, nu2=self.nu2 + 5, limit_correction=True,
                        stall_window=0)
 
@@ -143,8 +147,7 @@ class Problem:
     neumann_outlet: bool = False
     moes_M: float = 100.0
     moes_L: float = 0.0
-    #: starved inlet (:mod:`ehlfoam.contact.inlet`): the oil layer carried in at x_min
-    #: (units a^2/R; film content upstream of X = theta_x_max), or the meniscus X (units a)
+    #: starved inlet (:mod:`ehlfoam.contact.inlet`): layer at x_min [a^2/R] or meniscus X [a]
     inlet_layer: float | None = None
     inlet_meniscus_x: float | None = None
     theta_x_max: float = 0.0
@@ -181,7 +184,7 @@ class Level:
         self._W = np.zeros((ny, nx))
         self.theta = np.ones((ny, nx))  # film content (starved inlet), 1: a full gap
         self.dry = np.zeros((ny, nx), dtype=bool)  # held at P = p_floor (starved inlet)
-        self.march = True  # theta marched here; a coarse level of a cycle takes the fine's
+        self.march = True  # theta marched here (else fixed: see SolverOptions)
 
     def load(self, P: np.ndarray) -> float:
         return self.h * self.h * float(P.sum())
@@ -215,27 +218,18 @@ class Level:
         wedge = np.zeros_like(P)
         f = self.f if f is None else f
         if not raw:
-            self.update_inlet(P, H, rho, eps, f, prob)
+            update_inlet(self, P, H, rho, eps, f, prob)
         rhoH = rho * H * self.theta if prob.inlet_layer is not None else rho * H
         self._residual(P, rhoH, eps, f, self.h, self.h, r, wedge)
         if not raw:
             r[((P <= prob.p_floor) & (r > 0.0)) | self.dry] = 0.0
         return r, wedge, H
 
-    def update_inlet(self, P, H, rho, eps, f, prob: Problem) -> None:
-        """The starved inlet's film content and dry points at pressure P (none: no-op)."""
-        if prob.inlet_layer is not None and self.march:
-            march_theta(P, rho * H, eps, f, self.h, prob.inlet_layer,
-                        int(np.searchsorted(self.x, prob.theta_x_max)), prob.p_floor,
-                        self.theta, self.dry)
-        elif prob.inlet_meniscus_x is not None:
-            self.dry = meniscus_mask(self.x, self.ny, prob.inlet_meniscus_x)
-
     def relax(self, H0: float, prob: Problem, opt: SolverOptions) -> None:
         self.sweeps += 1
         H, rho, drho, eps, deps, ln_eta = self.coefficients(self.P, H0, prob)
         P_old = self.P.copy() if opt.max_ln_eta_step > 0.0 else None
-        self.update_inlet(self.P, H, rho, eps, self.f, prob)
+        update_inlet(self, self.P, H, rho, eps, self.f, prob)
         if prob.inlet_layer is not None:  # the wedge d(rho theta H)/dX
             rho, drho = rho * self.theta, drho * self.theta
         self._relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
@@ -327,8 +321,7 @@ class MultigridSolver:
         r, _, H = lv.residual(lv.P, self.H0, prob)
         P_hat = restrict_pressure(lv.P, prob.p_floor)
         co.P = P_hat.copy()
-        # the fine film content, fixed on the coarse level (a consistent FAS operator)
-        co.theta, co.march = lv.theta[::2, ::2].copy(), False
+        co.theta, co.march = lv.theta[::2, ::2].copy(), not opt.fixed_coarse_theta  # fine's
         co.dry = co.theta < 1.0
         # film FAS correction: the coarse film of P_hat is the fine film at the coarse points
         H_hat = H[::2, ::2]
@@ -475,9 +468,13 @@ class MultigridSolver:
                 break
             if cycles >= opt.max_cycles:
                 break
-            if self._stalled(history):
-                self.opt = opt = opt.stalled()
-                stalled_at = cycles
+            if self._stalled(history[stalled_at or 0:]):  # a starved inlet's may stall twice
+                if stalled_at is None:
+                    stalled_at, window = cycles, opt.stall_window
+                    self.opt = opt = replace(opt.stalled(), stall_window=window
+                                             if self.prob.inlet_layer is not None else 0)
+                else:
+                    self.opt = opt = replace(opt, fixed_coarse_theta=True, stall_window=0)
             self._cycle(top)
             cycles += 1
             res, load_err, H = self.measure()
