@@ -16,10 +16,10 @@ on the same grid and domain:
    contact whole) and hc -> hc,ff (a thick one floods it).
 2. Inlet meniscus (``inlet_meniscus``, distance upstream of x = -a in units of a; Hamrock
    and Dowson's dimensionless inlet distance is m = 1 + inlet_meniscus): hc / hc,ff beside
-   Hamrock and Dowson's starved point-contact fit (J. Lubr. Technol. 99 (1977) 15) as the
-   issue states it, hc / hc,ff = ((m - 1) / (m* - 1))^0.29 for m < m*, 1 beyond, with
-   m* = 1 + 3.06 ((R / b)^2 hc,ff / R)^0.58 (b = a for a circular contact, so
-   (R / a)^2 hc,ff / R is hc,ff in units a^2 / R); and the onset of starvation, the
+   Hamrock and Dowson's starved point-contact fit (J. Lubr. Technol. 99 (1977) 15) as
+   commonly quoted (the paper not consulted), hc / hc,ff = ((m - 1) / (m* - 1))^0.29 for
+   m < m*, 1 beyond, with m* = 1 + 3.06 ((R / b)^2 hc,ff / R)^0.58 (b = a for a circular
+   contact, so (R / a)^2 hc,ff / R is hc,ff in units a^2 / R); and the onset of starvation, the
    largest m where hc / hc,ff < 0.97, beside m* (Wedeven, Evans and Cameron 1971 found
    the film falling once the meniscus comes within such a distance; no constant of theirs
    is used).
