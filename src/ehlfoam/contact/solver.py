@@ -235,7 +235,7 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
     starved = spec.inlet_layer is not None or spec.inlet_meniscus is not None
     if starved:
         dom = starved_domain(spec, dom)
-        if flooded is None:
+        if flooded is None or flooded.domain != dom:  # the same grid and domain only
             flooded = solve(spec.model_copy(update=dict(inlet_layer=None, inlet_meniscus=None)),
                             options, start, domain=dom)
     opt = options or SolverOptions(max_cycles=spec.max_cycles, tol_residual=spec.tol_residual,
