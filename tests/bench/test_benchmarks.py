@@ -141,3 +141,21 @@ def test_ladder_accuracy_measures_each_rung_against_the_finest_at_rest(tmp_path)
     assert [s["rung"] for s in rec["summary"]] == ["thin-film-coarse", "thin-film-medium"]
     assert rec["summary"][1]["max_width"] == 0 and rec["summary"][1]["cpu_over_reference"] == 1
     assert len(table_rows(stdout, "rung  points")) == 2
+
+
+@pytest.mark.slow
+def test_starved_film_follows_the_starvation_relations(tmp_path):
+    stdout, rec = run_bench("starved_film", tmp_path)
+    assert "Chevalier" in stdout and "Hamrock-Dowson" in stdout
+    (point,) = rec["points"]
+    layer, men = point["layer"], point["meniscus"]
+    assert [r[0] for r in table_rows(stdout, "h_oil/hc,ff")] == ["50.00", "1.00", "0.50", "0.20"]
+    assert all(r["converged"] for r in layer + men)
+    ratios = [r["hc_ratio"] for r in layer]
+    assert ratios == sorted(ratios, reverse=True)  # thinner layer, thinner film
+    assert ratios[0] == pytest.approx(1.0, abs=3e-3)  # a thick layer floods the contact
+    assert all(r["hc_ratio"] <= r["r"] * (1 + 1e-9) for r in layer)  # hc <= h_oil
+    assert point["layer_mass_ok"]
+    assert point["worst_chevalier"] < 0.02 and 1.0 < point["gamma_fit"] < 10.0
+    assert point["worst_hamrock_dowson"] < 0.06
+    assert 1.0 < point["onset_m"] < point["m_star"] + 0.5

@@ -32,6 +32,10 @@ _OPTIONS = {
     "--viscosity": ("viscosity", str, "roelands (default) or barus"),
     "--density": ("density", str, "dowson-higginson (default) or incompressible"),
     "--cavitation": ("cavitation", str, "complementarity (default, p >= 0) or twophase"),
+    "--inlet-layer": ("inlet_layer", float, "starved inlet: oil layer carried in, both "
+                      "surfaces together [m] (default: fully flooded)"),
+    "--inlet-meniscus": ("inlet_meniscus", float, "starved inlet: meniscus distance upstream "
+                         "of x = -a [a] (default: fully flooded)"),
     "--grid": ("grid", int, "grid points per side, 2^k+1 (default: chosen from M)"),
     "--max-cycles": ("max_cycles", int, "multigrid cycle limit (default 100)"),
 }

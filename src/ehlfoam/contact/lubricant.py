@@ -219,3 +219,28 @@ def _coefficients(P, H, lam, params, rho, drho, eps, deps, ln_eta):
 #: :func:`_coefficients` on one thread and on numba's threads (large grids)
 coefficients = njit(cache=True)(_coefficients)
 coefficients_parallel = njit(parallel=True, cache=True)(_coefficients)
+
+
+def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
+                         max_step: float, ln_eta_old: np.ndarray | None = None) -> None:
+    """Damp a relaxation sweep where it would change the viscosity by more than a factor
+    e^max_step; updates the dimensionless pressure ``P`` in place (``ln_eta_old``: the laws'
+    ln(eta / eta0) at ``P_old`` where known).
+
+    The line systems hold eps = rho H^3 / (eta lambda) frozen, so where the pressure-viscosity
+    product alpha pH is large (Moes L >= 20) a step of a few tenths in P changes eta by orders
+    of magnitude and the next sweep overshoots: the pressure spike runs away to
+    exp(alpha p) overflow. Scaling the step at such points to |d ln(eta)| = max_step keeps the
+    fixed point (the limiter is inactive once the steps are small) and only slows the first
+    sweeps of a large-L solve.
+    """
+    dP_max = float(np.max(np.abs(P - P_old)))
+    if dP_max * laws.max_dln_eta_dP(max(float(P.max()), float(P_old.max()))) <= max_step:
+        return  # no point can have changed ln(eta) by more than max_step
+    if ln_eta_old is None:
+        ln_eta_old = laws.ln_eta(P_old)
+    d_ln_eta = np.abs(laws.ln_eta(P) - ln_eta_old)
+    big = d_ln_eta > max_step
+    if np.any(big):
+        dP = P[big] - P_old[big]
+        P[big] = P_old[big] + dP * (max_step / d_ln_eta[big])

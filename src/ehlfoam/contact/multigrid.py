@@ -13,8 +13,8 @@ FAS correction of the film (fine deformation minus coarse deformation of the inj
 pressure) and of the load. H0 is relaxed against the load on the coarsest level, whose
 problem is solved (rounds of sweeps and H0 steps). Full multigrid (FMG) start from a
 Hertzian pressure on the coarsest level, each finer level cycled to its own discretisation
-error; the finest level until its film has settled (see :class:`SolverOptions`). Grid
-transfers: :mod:`ehlfoam.contact.transfer`.
+error; the finest level until its film has settled (see :class:`SolverOptions`). Transfers:
+:mod:`ehlfoam.contact.transfer`; a starved inlet's film content: :mod:`ehlfoam.contact.inlet`.
 """
 
 from __future__ import annotations
@@ -27,7 +27,9 @@ import numpy as np
 from scipy.ndimage import minimum_filter
 
 from ehlfoam.contact.elastic import Deformation, hertz_pressure
+from ehlfoam.contact.inlet import meniscus_mask, update_inlet
 from ehlfoam.contact.lubricant import PressureLaws, coefficients, coefficients_parallel
+from ehlfoam.contact.lubricant import limit_viscosity_step
 from ehlfoam.contact.reynolds import relax, relax_parallel, residual, residual_parallel
 from ehlfoam.contact.threads import PARALLEL_MIN_POINTS, numba_threads, solve_threads
 from ehlfoam.contact.transfer import (prolong_bilinear, prolong_cubic, restrict_full_weighting,
@@ -88,6 +90,8 @@ class SolverOptions:
         before; the solve then goes on with :meth:`stalled` options (once).
     workers: threads of the solve (scipy.fft and the numba kernels); None: the caller's
         numba thread count (:func:`solve_threads`).
+    fixed_coarse_theta: a starved inlet's coarse levels take the fine film content fixed
+        instead of marching their own (the stalled options set it).
     """
 
     nu1: int = 2
@@ -121,12 +125,14 @@ class SolverOptions:
     stall_ratio: float = 0.7
     workers: int | None = None
     zebra: bool = True
+    fixed_coarse_theta: bool = False
 
     def stalled(self) -> "SolverOptions":
         """Options for the rest of a stalled solve (large L: a limit cycle between the pressure
         spike's side lobes and the coarse-grid correction): half the distributive-Jacobi
         under-relaxation, five more fine sweeps after each coarse-grid correction, and the
-        correction itself held to the viscosity-step limit."""
+        correction itself held to the viscosity-step limit. (A starved inlet's solve is watched
+        for a second stall, which fixes the coarse film content: :meth:`_solve`.)"""
         return replace(self, w_ja=0.5 * self.w_ja, nu2=self.nu2 + 5, limit_correction=True,
                        stall_window=0)
 
@@ -141,6 +147,10 @@ class Problem:
     neumann_outlet: bool = False
     moes_M: float = 100.0
     moes_L: float = 0.0
+    #: starved inlet (:mod:`ehlfoam.contact.inlet`): layer at x_min [a^2/R] or meniscus X [a]
+    inlet_layer: float | None = None
+    inlet_meniscus_x: float | None = None
+    theta_x_max: float = 0.0
 
     @property
     def params(self) -> np.ndarray:
@@ -172,6 +182,9 @@ class Level:
         self._coef = [np.empty((ny, nx)) for _ in range(5)]
         self._W_of: np.ndarray | None = None  # the pressure whose deformation is self._W
         self._W = np.zeros((ny, nx))
+        self.theta = np.ones((ny, nx))  # film content (starved inlet), 1: a full gap
+        self.dry = np.zeros((ny, nx), dtype=bool)  # held at P = p_floor (starved inlet)
+        self.march = True  # theta marched here (else fixed: see SolverOptions)
 
     def load(self, P: np.ndarray) -> float:
         return self.h * self.h * float(P.sum())
@@ -203,47 +216,29 @@ class Level:
         H, rho, _, eps, _, _ = self.coefficients(P, H0, prob, H)
         r = np.zeros_like(P)
         wedge = np.zeros_like(P)
-        self._residual(P, rho * H, eps, self.f if f is None else f, self.h, self.h, r, wedge)
+        f = self.f if f is None else f
         if not raw:
-            r[(P <= prob.p_floor) & (r > 0.0)] = 0.0
+            update_inlet(self, P, H, rho, eps, f, prob)
+        rhoH = rho * H * self.theta if prob.inlet_layer is not None else rho * H
+        self._residual(P, rhoH, eps, f, self.h, self.h, r, wedge)
+        if not raw:
+            r[((P <= prob.p_floor) & (r > 0.0)) | self.dry] = 0.0
         return r, wedge, H
 
     def relax(self, H0: float, prob: Problem, opt: SolverOptions) -> None:
         self.sweeps += 1
         H, rho, drho, eps, deps, ln_eta = self.coefficients(self.P, H0, prob)
         P_old = self.P.copy() if opt.max_ln_eta_step > 0.0 else None
+        update_inlet(self, self.P, H, rho, eps, self.f, prob)
+        if prob.inlet_layer is not None:  # the wedge d(rho theta H)/dX
+            rho, drho = rho * self.theta, drho * self.theta
         self._relax(self.P, H, rho, drho, eps, self.f, self.h, self.h, self.K0, self.K1,
                     opt.switch, opt.w_gs, opt.w_ja, prob.p_floor, prob.neumann_outlet,
-                    self.work, deps, True, opt.zebra)
+                    self.work, deps, self.dry, True, opt.zebra)
         if P_old is not None:
             limit_viscosity_step(P_old, self.P, prob.laws, opt.max_ln_eta_step, ln_eta)
             if prob.neumann_outlet:
                 self.P[:, -1] = self.P[:, -2]
-
-
-def limit_viscosity_step(P_old: np.ndarray, P: np.ndarray, laws: PressureLaws,
-                         max_step: float, ln_eta_old: np.ndarray | None = None) -> None:
-    """Damp a relaxation sweep where it would change the viscosity by more than a factor
-    e^max_step; updates the dimensionless pressure ``P`` in place (``ln_eta_old``: the laws'
-    ln(eta / eta0) at ``P_old`` where known).
-
-    The line systems hold eps = rho H^3 / (eta lambda) frozen, so where the pressure-viscosity
-    product alpha pH is large (Moes L >= 20) a step of a few tenths in P changes eta by orders
-    of magnitude and the next sweep overshoots: the pressure spike runs away to
-    exp(alpha p) overflow. Scaling the step at such points to |d ln(eta)| = max_step keeps the
-    fixed point (the limiter is inactive once the steps are small) and only slows the first
-    sweeps of a large-L solve.
-    """
-    dP_max = float(np.max(np.abs(P - P_old)))
-    if dP_max * laws.max_dln_eta_dP(max(float(P.max()), float(P_old.max()))) <= max_step:
-        return  # no point can have changed ln(eta) by more than max_step
-    if ln_eta_old is None:
-        ln_eta_old = laws.ln_eta(P_old)
-    d_ln_eta = np.abs(laws.ln_eta(P) - ln_eta_old)
-    big = d_ln_eta > max_step
-    if np.any(big):
-        dP = P[big] - P_old[big]
-        P[big] = P_old[big] + dP * (max_step / d_ln_eta[big])
 
 
 @dataclass
@@ -268,6 +263,8 @@ class MGResult:
     fmg_hc: list = field(default_factory=list)
     #: relaxation sweeps of all levels in units of one finest-level sweep
     work_units: float = 0.0
+    #: film content of the finest level (starved inlet; 1 elsewhere), None if not kept
+    theta: np.ndarray | None = None
 
 
 class MultigridSolver:
@@ -300,6 +297,8 @@ class MultigridSolver:
         else:
             P[:, -1] = 0.0
         np.maximum(P, self.prob.p_floor, out=P)
+        if self.prob.inlet_meniscus_x is not None:
+            P[meniscus_mask(lv.x, lv.ny, self.prob.inlet_meniscus_x)] = self.prob.p_floor
 
     def _solve_coarsest(self) -> None:
         lv = self.levels[0]
@@ -322,6 +321,8 @@ class MultigridSolver:
         r, _, H = lv.residual(lv.P, self.H0, prob)
         P_hat = restrict_pressure(lv.P, prob.p_floor)
         co.P = P_hat.copy()
+        co.theta, co.march = lv.theta[::2, ::2].copy(), not opt.fixed_coarse_theta  # fine's
+        co.dry = co.theta < 1.0
         # film FAS correction: the coarse film of P_hat is the fine film at the coarse points
         H_hat = H[::2, ::2]
         co.tauW = H_hat - self.H0 - co.rigid - co.deform(P_hat)
@@ -467,9 +468,13 @@ class MultigridSolver:
                 break
             if cycles >= opt.max_cycles:
                 break
-            if self._stalled(history):
-                self.opt = opt = opt.stalled()
-                stalled_at = cycles
+            if self._stalled(history[stalled_at or 0:]):  # a starved inlet's may stall twice
+                if stalled_at is None:
+                    stalled_at, window = cycles, opt.stall_window
+                    self.opt = opt = replace(opt.stalled(), stall_window=window
+                                             if self.prob.inlet_layer is not None else 0)
+                else:
+                    self.opt = opt = replace(opt, fixed_coarse_theta=True, stall_window=0)
             self._cycle(top)
             cycles += 1
             res, load_err, H = self.measure()
@@ -488,4 +493,4 @@ class MultigridSolver:
                         work_units=self.work_units(),
                         converged=converged, residual=res, load_error=load_err, cycles=cycles,
                         history=history, wall_s=time.perf_counter() - t0, failure=failure,
-                        stalled_at=stalled_at, fmg_hc=fmg_hc)
+                        stalled_at=stalled_at, fmg_hc=fmg_hc, theta=lv.theta.copy())

@@ -96,7 +96,7 @@ def _penta_solve(a, b, c, d, e, rhs, x):
 
 @njit(cache=True, inline="always")
 def _line(j, P, H, rho, drho, eps, rhoH, f, hx, K0, Kt, switch, w_gs, p_floor, neumann_out,
-          D, deps, point_ja, a, b, c, d, e, rhs, x, gs, frozen):
+          D, deps, point_ja, a, b, c, d, e, rhs, x, gs, frozen, dry):
     """Relax X-line ``j`` (a Newton step on its pentadiagonal system): Gauss-Seidel points
     are updated, distributive-Jacobi changes stored in D. Returns the number of the
     latter."""
@@ -113,7 +113,7 @@ def _line(j, P, H, rho, drho, eps, rhoH, f, hx, K0, Kt, switch, w_gs, p_floor, n
         gs[m] = eps[j, i] >= switch * hx2 or (
             P[j, i] <= p_floor or P[j, i - 1] <= p_floor or P[j, i + 1] <= p_floor
             or P[j - 1, i] <= p_floor or P[j + 1, i] <= p_floor)
-        frozen[m] = P[j, i] <= p_floor and rr > 0.0
+        frozen[m] = (P[j, i] <= p_floor and rr > 0.0) or dry[j, i]
     for m in range(n):
         i = m + 1
         a[m] = 0.0
@@ -218,7 +218,7 @@ def _line(j, P, H, rho, drho, eps, rhoH, f, hx, K0, Kt, switch, w_gs, p_floor, n
 
 
 def _relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, p_floor, neumann_out, D,
-           deps, point_ja=True, zebra=False):
+           deps, dry, point_ja=True, zebra=False):
     """One X-line relaxation sweep; updates P in place.
 
     Args:
@@ -237,6 +237,8 @@ def _relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, p_floor,
             its Poiseuille contribution enters the diagonal where it strengthens it (just
             behind the pressure spike, where the pressure falls steeply and eps grows by
             orders of magnitude within a cell, the frozen-eps Newton step overshoots).
+        dry: points held at P = p_floor whatever their residual (a starved inlet: the
+            film-content region, or upstream of a prescribed meniscus).
         zebra: the odd lines first, then the even ones (each half in parallel), instead
             of the lines in order.
     Returns:
@@ -260,21 +262,22 @@ def _relax(P, H, rho, drho, eps, f, hx, hy, K0, K1, switch, w_gs, w_ja, p_floor,
                               p_floor, neumann_out, D, deps, point_ja, np.empty(n),
                               np.empty(n), np.empty(n), np.empty(n), np.empty(n),
                               np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_),
-                              np.empty(n, dtype=np.bool_))
+                              np.empty(n, dtype=np.bool_), dry)
     else:
         a, b, c, d, e = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
         rhs, x = np.empty(n), np.empty(n)
         gs, frozen = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
         for j in range(1, ny - 1):
             n_ja += _line(j, P, H, rho, drho, eps, rhoH, f, hx, K0, Kt, switch, w_gs, p_floor,
-                          neumann_out, D, deps, point_ja, a, b, c, d, e, rhs, x, gs, frozen)
+                          neumann_out, D, deps, point_ja, a, b, c, d, e, rhs, x, gs, frozen,
+                          dry)
     if n_ja > 0:
         # the distribution d at (j, i) and -d/4 at its four neighbours (interior points
         # only), gathered point by point
         for j in prange(1, ny - 1):
             for i in range(1, nx - 1):
                 dd = D[j, i] - 0.25 * (D[j, i - 1] + D[j, i + 1] + D[j - 1, i] + D[j + 1, i])
-                if dd != 0.0:
+                if dd != 0.0 and not dry[j, i]:
                     v = P[j, i] + w_ja * dd
                     P[j, i] = v if v > p_floor else p_floor
         if neumann_out:

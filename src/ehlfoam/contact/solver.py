@@ -11,6 +11,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ehlfoam.contact.formulas import Contact, moes_to_hertz_film, nijenbanning_moes_hc
+from ehlfoam.contact.inlet import meniscus_x_on_centreline
 from ehlfoam.contact.multigrid import Domain, MGResult, MultigridSolver, Problem, SolverOptions
 from ehlfoam.contact.spec import P_AMBIENT_PA, PrecalcSpec
 from ehlfoam.contact.twophase import SubAmbientResult, solve_subambient
@@ -37,6 +38,15 @@ def domain_for(spec: PrecalcSpec, M: float, n: int) -> Domain:
         return Domain(-2.5, 1.5, 2.0, n, n)
     # heavily loaded: the inlet zone is a fraction of a; spend the points near the contact
     return Domain(-1.8, 1.2, 1.5, n, n)
+
+
+def starved_domain(spec: PrecalcSpec, dom: Domain) -> Domain:
+    """The domain of a starved solve: ``dom``, its inlet moved upstream (square cells kept)
+    when a prescribed meniscus lies less than 0.25 a inside it."""
+    if spec.inlet_meniscus is None or -1.0 - spec.inlet_meniscus > dom.x_min + 0.25:
+        return dom
+    x_min = -1.0 - spec.inlet_meniscus - 0.25
+    return Domain(x_min, dom.x_max, 0.5 * (dom.x_max - x_min), dom.nx, dom.ny)
 
 
 @dataclass(frozen=True)
@@ -85,6 +95,8 @@ class PrecalcResult:
     wall_s: float
     continuation: list
     subambient: SubAmbientResult | None = None
+    #: the same contact fully flooded, on the same grid (starved inlet only)
+    flooded: "PrecalcResult | None" = None
 
     @property
     def converged(self) -> bool:
@@ -110,6 +122,21 @@ class PrecalcResult:
         while end + 1 < len(x) and p[end + 1] < below:
             end += 1
         return float(x[end] - 1.0)
+
+    def starved_summary(self) -> dict:
+        """The starved film against the flooded one, and the inlet meniscus on y = 0 (its
+        distance upstream of x = -a, units a; None where the centreline never pressurises)."""
+        ff, mg, scale = self.flooded, self.mg, self.contact.film_scale
+        x_m = meniscus_x_on_centreline(mg.x, mg.y, mg.P, mg.theta
+                                       if self.spec.inlet_layer is not None else None)
+        out = {"hc_flooded_m": ff.H_central * scale, "hmin_flooded_m": float(ff.mg.H.min()) * scale,
+               "hc_over_hc_flooded": self.H_central / ff.H_central,
+               "hmin_over_hmin_flooded": float(mg.H.min()) / float(ff.mg.H.min()),
+               "inlet_meniscus_over_a": None if x_m is None else -1.0 - x_m,
+               "flooded_converged": bool(ff.converged)}
+        if self.spec.inlet_layer is not None:
+            out["inlet_layer_over_hc_flooded"] = self.spec.inlet_layer / out["hc_flooded_m"]
+        return out
 
     def summary(self) -> dict:
         """The JSON contract (SI units, plus dimensionless groups)."""
@@ -143,6 +170,8 @@ class PrecalcResult:
             "continuation_M": self.continuation,
             "spec": self.spec.model_dump(),
         }
+        if self.flooded is not None:
+            out.update(self.starved_summary())
         if self.spec.cavitation == "twophase":
             length = self.cavity_length_over_a()
             out["cavity_length_over_a"] = length
@@ -183,12 +212,17 @@ def _ramp(solver, prob, opt, c, factor: float, start: float, h0_guess):
 
 
 def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
-          start: Start | None = None) -> PrecalcResult:
+          start: Start | None = None, flooded: PrecalcResult | None = None,
+          domain: Domain | None = None) -> PrecalcResult:
     """Solve the EHL contact of ``spec``: full multigrid from a Hertzian start, then cycles
     to convergence (:class:`~ehlfoam.contact.multigrid.MultigridSolver`); or, given a
     neighbouring solution ``start`` (not for the two-phase option), cycles from its pressure
     and its film constant shifted by the NVM films' difference, falling back to the full
     multigrid start if that does not converge.
+
+    A starved inlet (``spec.inlet_layer`` or ``spec.inlet_meniscus``) is solved beside the
+    same contact fully flooded on the same grid (``flooded``: that solve, if already done);
+    ``domain`` overrides the domain's choice.
 
     Only when that direct start fails is the solution reached by a speed ramp: M is stepped
     up by factors of at most 2 from M <= :data:`CONTINUATION_M` / 4, each step starting
@@ -197,14 +231,24 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
     t0 = time.perf_counter()
     c = spec.contact()
     n = spec.grid or default_grid(c.M)
-    dom = domain_for(spec, c.M, n)
+    dom = domain or domain_for(spec, c.M, n)
+    starved = spec.inlet_layer is not None or spec.inlet_meniscus is not None
+    if starved:
+        dom = starved_domain(spec, dom)
+        if flooded is None or flooded.domain != dom:  # the same grid and domain only
+            flooded = solve(spec.model_copy(update=dict(inlet_layer=None, inlet_meniscus=None)),
+                            options, start, domain=dom)
     opt = options or SolverOptions(max_cycles=spec.max_cycles, tol_residual=spec.tol_residual,
                                    tol_load=spec.tol_load)
     twophase = spec.cavitation == "twophase"
     # two-phase: sub-ambient pressures allowed down to absolute zero (gauge -p_ambient)
     p_floor = -P_AMBIENT_PA / c.p_hertz if twophase else 0.0
     prob = Problem(lam=c.lam, laws=spec.laws(), p_floor=p_floor, neumann_outlet=twophase,
-                   moes_M=c.M, moes_L=c.L)
+                   moes_M=c.M, moes_L=c.L,
+                   inlet_layer=None if spec.inlet_layer is None
+                   else spec.inlet_layer / c.film_scale,
+                   inlet_meniscus_x=None if spec.inlet_meniscus is None
+                   else -1.0 - spec.inlet_meniscus)
     solver = MultigridSolver(prob, dom, opt)
 
     def h0_at(M: float) -> float:
@@ -247,4 +291,4 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
                               f"iterations (residual {subambient.residual:.3g})")
     return PrecalcResult(spec=spec, contact=c, domain=dom, mg=result,
                          wall_s=time.perf_counter() - t0, continuation=ramp,
-                         subambient=subambient)
+                         subambient=subambient, flooded=flooded if starved else None)

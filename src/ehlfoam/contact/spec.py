@@ -78,6 +78,18 @@ class PrecalcSpec(BaseModel):
                     "p / p_s) for gauge p < 0; the default, the ambient pressure, makes the "
                     "density proportional to the absolute pressure.",
         json_schema_extra={"unit": "Pa"})
+    inlet_layer: float | None = Field(
+        None, gt=0.0, le=1e-3,
+        description="Starved inlet: the oil carried into the contact, both surfaces together, "
+                    "as a layer thickness (mass-conserving film content upstream of the "
+                    "contact centre); none: fully flooded.",
+        json_schema_extra={"unit": "m"})
+    inlet_meniscus: float | None = Field(
+        None, gt=0.0, le=50.0,
+        description="Starved inlet: the inlet meniscus, its distance upstream of the contact's "
+                    "leading edge x = -a in units of a (the pressure is zero upstream of it); "
+                    "none: fully flooded.",
+        json_schema_extra={"unit": "a"})
     grid: int | None = Field(None, description="Grid points along y, 2^k + 1 (65 to 8193); "
                                                "none: chosen from the Moes load parameter.")
     max_cycles: int = Field(100, ge=1, le=1000, description="Most multigrid cycles.")
@@ -127,6 +139,29 @@ class PrecalcSpec(BaseModel):
         if not lo <= self.temperature <= hi:
             raise SpecError(f"temperature = {self.temperature:g} C is outside the "
                             f"{self.lubricant} table: valid range {lo:g} to {hi:g} C")
+        return self
+
+    @model_validator(mode="before")
+    @classmethod
+    def _meniscus_outside_contact(cls, data):
+        """A meniscus at or inside the contact's leading edge named as such."""
+        m = data.get("inlet_meniscus") if isinstance(data, dict) else None
+        if isinstance(m, (int, float)) and not isinstance(m, bool) and m <= 0.0:
+            raise SpecError(f"inlet_meniscus = {m:g} a puts the meniscus at x = {-1.0 - m:g} a, "
+                            "not upstream of the contact's leading edge x = -a: valid range "
+                            "0 < inlet_meniscus <= 50 a (distance upstream of x = -a)")
+        return data
+
+    @model_validator(mode="after")
+    def _one_inlet_supply(self) -> "PrecalcSpec":
+        if self.inlet_layer is not None and self.inlet_meniscus is not None:
+            raise SpecError(f"inlet_layer = {self.inlet_layer:g} m and inlet_meniscus = "
+                            f"{self.inlet_meniscus:g} a are both set: give one of them (or "
+                            "neither: fully flooded)")
+        if self.cavitation == "twophase" and (self.inlet_layer is not None
+                                              or self.inlet_meniscus is not None):
+            raise SpecError("a starved inlet (inlet_layer, inlet_meniscus) needs cavitation = "
+                            "'complementarity', not 'twophase'")
         return self
 
     # --- derived quantities (the one place they are computed) ---------------------------

@@ -26,8 +26,10 @@ class PrecalcFailed(RuntimeError):
 
 
 def spec_key(spec: PrecalcSpec) -> str:
-    """A stable hash of everything that changes the solution."""
-    return hashlib.sha256(spec.model_dump_json().encode()).hexdigest()[:16]
+    """A stable hash of everything that changes the solution (the starved-inlet keys only
+    when set, so a flooded spec keeps the key it had before they existed)."""
+    unset = {k for k in ("inlet_layer", "inlet_meniscus") if getattr(spec, k) is None}
+    return hashlib.sha256(spec.model_dump_json(exclude=unset).encode()).hexdigest()[:16]
 
 
 def precalc_dir(spec: PrecalcSpec, cache: Path | None = None, require_converged: bool = True) -> Path:
