@@ -21,12 +21,13 @@ TRUST = {
         "thin-film (gap-averaged, seconds a case): inlet meniscus 4.9 a against the converged "
         "3D 5.6 a (12 % downstream), flooded width 15.4 a against 14.7 a (5 % wide); its "
         "bubble is the gas-release scene's with an instant release (within 7 % of the 3D bath "
-        "at 99 kPa); a state within a speed step of the transition can flip with the grid or "
-        "the start (docs/models/thin-film.md)."),
+        "at 99 kPa); at six reference points its medium level is within 8 % of the finest "
+        "rung at rest; a state within a speed step of the transition can flip with the grid "
+        "or the start (docs/ladder.md#speed-against-accuracy)."),
     "coarse": (
         "3D coarse (minutes a case): a first look; the flooded width 17-21 % short of the "
-        "converged one, the inlet some 16 % upstream; three transits are not a rest "
-        "(docs/validation.md)."),
+        "converged one, the inlet some 16 % upstream; a few transits are not a rest "
+        "(docs/ladder.md#speed-against-accuracy)."),
     "medium": (
         "3D medium: the default levels' width 17-21 % short of the converged one "
         "(docs/validation.md)."),
