@@ -6,6 +6,7 @@ next, over speed x supply at the reference conditions (HVI60, 40 C, 20 N, gas be
         [--supplies 0.3 0.6 1.1 2 4] [--levels coarse medium fine] [--wall-limit 120]
         [--3d-speeds 4.373 9.564 20.91] [--3d-supplies 0.6 2] [--3d-wall-limit 240]
         [--3d-from thin-film|puddle] [--no-3d] [--jobs 1] [--out FILE.json]
+    python bench/stability_maps.py --work DIR --collect    # the maps of what has run
     python bench/stability_maps.py --quick
 
 Every point runs through the batch (``ehlfoam batch``'s own engine, ``run_batch``), from
@@ -51,11 +52,12 @@ from ehlfoam.batch.results import read_results
 
 LEVELS = ("coarse", "medium", "fine")
 OUTCOMES = ("rest I", "rest II", "not at rest (end_time)", "not at rest (wall_limit)",
-            "failed")
+            "failed", "not run")
 # outcome -> (marker, colour) on the maps
 STYLE = {"rest I": ("o", "#1f77b4"), "rest II": ("^", "#d62728"),
          "not at rest (end_time)": ("s", "#ff7f0e"),
-         "not at rest (wall_limit)": ("D", "#9467bd"), "failed": ("X", "black")}
+         "not at rest (wall_limit)": ("D", "#9467bd"), "failed": ("X", "black"),
+         "not run": ("o", "none")}
 
 BASE = """
 [base]
@@ -138,6 +140,8 @@ def one_line(text: str, width: int = 160) -> str:
 
 def outcome(row: dict) -> str:
     """The point's class from its results.csv row."""
+    if row["status"] in ("pending", "interrupted", "running"):
+        return "not run"
     if row["status"] != "finished":
         return "failed"
     if row["end_reason"] == "steady":
@@ -162,7 +166,7 @@ def point_rows(batch: Path, rung_of: Any) -> list[dict]:
     for r in read_results(batch):
         case = batch / r["case_dir"]
         reason = ""
-        if r["status"] != "finished" or outcome(r) == "failed":
+        if outcome(r) == "failed":
             reason = one_line(r.get("reason") or "")
             if not reason and r.get("log") and (batch / r["log"]).is_file():
                 reason = one_line((batch / r["log"]).read_text(errors="replace"))
@@ -181,7 +185,8 @@ def point_rows(batch: Path, rung_of: Any) -> list[dict]:
             "bubble_length_over_a": _float(r.get("bubble_length_over_a")),
             "bubble_enclosed": r.get("bubble_enclosed") or "",
             "cells": int(r["cells"]) if r.get("cells") else None,
-            "cost_s": cost if cost is not None else _float(r.get("wall_s")),
+            "cost_s": None if outcome(r) == "not run"
+            else cost if cost is not None else _float(r.get("wall_s")),
             "failure_reason": reason})
     return rows
 
@@ -199,8 +204,9 @@ def compare(rows: list[dict], rungs: list[str], against: dict[str, str]) -> None
         r["vs_state"] = other["state"] if other else ""
         r["flips"] = bool(other and r["state"] and other["state"]
                           and r["state"] != other["state"])
-        for m in METRICS:
-            a, b = r.get(m), other.get(m) if other else None
+        for m in METRICS:   # the interface scene has no gas: no bubble to compare
+            gasless = m == "bubble_length_over_a" and r["rung"].startswith("3D")
+            a, b = r.get(m), other.get(m) if other and not gasless else None
             r[f"d_{m}"] = a - b if a is not None and b is not None else None
 
 
@@ -211,12 +217,13 @@ def summary(rows: list[dict], rungs: list[str]) -> list[dict]:
         mine = [r for r in rows if r["rung"] == rung]
         if not mine:
             continue
+        costs = [r["cost_s"] for r in mine if r["cost_s"] is not None]
         s = {"rung": rung, "points": len(mine), "vs": mine[0]["vs"] or "-",
              **{o: sum(r["outcome"] == o for r in mine) for o in OUTCOMES},
              "flips": sum(r["flips"] for r in mine),
              "compared": sum(bool(r["vs_state"] and r["state"]) for r in mine),
-             "cost_median_s": sorted(r["cost_s"] or 0.0 for r in mine)[len(mine) // 2],
-             "cost_total_s": sum(r["cost_s"] or 0.0 for r in mine)}
+             "cost_median_s": sorted(costs)[len(costs) // 2] if costs else None,
+             "cost_total_s": sum(costs)}
         for m in METRICS:
             moves = [abs(r[f"d_{m}"]) for r in mine
                      if r[f"d_{m}"] is not None and not r["flips"]]
@@ -255,7 +262,8 @@ def draw(path: Path, rows: list[dict], rung: str, title: str) -> None:
         if pts:
             marker, colour = STYLE[name]
             ax.scatter([r["speed_m_s"] * 1e3 for r in pts], [r["supply_m"] * 1e6 for r in pts],
-                       marker=marker, c=colour, s=46, label=name, zorder=3)
+                       marker=marker, s=46, label=name, zorder=3,
+                       facecolors=colour, edgecolors=colour if colour != "none" else "grey")
     flips = [r for r in mine if r["flips"]]
     if flips:
         ax.scatter([r["speed_m_s"] * 1e3 for r in flips], [r["supply_m"] * 1e6 for r in flips],
@@ -279,6 +287,20 @@ def draw(path: Path, rows: list[dict], rung: str, title: str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path)
     plt.close(fig)
+
+
+def run(spec: Path, out: Path, args: argparse.Namespace, jobs: int | None = None
+        ) -> Path | None:
+    """Run the batch ``spec`` into ``out`` (``--collect``: only read what it holds): the
+    batch folder, or None if the batch was interrupted."""
+    if args.collect:
+        return out
+    done = run_batch(spec, BatchOptions(out=out, jobs=jobs or args.jobs, quiet=True,
+                                        regime=False, report=None))
+    if done.interrupted:
+        print("interrupted: run the same command again to resume")
+        return None
+    return done.batch_dir
 
 
 def thin_film_rung(row: dict) -> str:
@@ -305,6 +327,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--3d-from", dest="from_3d", choices=("thin-film", "puddle"),
                     default="thin-film")
     ap.add_argument("--no-3d", action="store_true", help="the thin-film levels only")
+    ap.add_argument("--collect", action="store_true",
+                    help="run nothing: classify what the work folder's batches hold (cases "
+                         "not run are drawn hollow)")
     ap.add_argument("--jobs", type=int, default=1, help="cases at once")
     ap.add_argument("--maps", type=Path, default=None, metavar="DIR",
                     help="where the CSV and the figures go (default: the work folder)")
@@ -328,13 +353,14 @@ def main(argv: list[str] | None = None) -> int:
                                                args.transits, args.wall_limit,
                                                QUICK if args.quick else ""))
         t0, load = time.perf_counter(), os.getloadavg()[0]
-        done = run_batch(spec, BatchOptions(out=work / "thin_film", jobs=args.jobs, quiet=True,
-                                            regime=False, report=None))
+        tf_dir = run(spec, work / "thin_film", args)
         record["thin_film_wall_s"] = time.perf_counter() - t0
-        rows = point_rows(done.batch_dir, thin_film_rung)
+        if tf_dir is None:
+            return 130
+        rows = point_rows(tf_dir, thin_film_rung)
         if not args.no_3d:
             seed_level = "medium" if "medium" in levels else levels[-1]
-            states = {(key(r["speed_m_s"]), r["supply_m"]): done.batch_dir / "cases" / r["case_id"]
+            states = {(key(r["speed_m_s"]), r["supply_m"]): tf_dir / "cases" / r["case_id"]
                       / "state.npz" for r in rows if r["rung"] == f"thin-film {seed_level}"}
             points = []
             for v in [key(s / 1e3) for s in args.speeds_3d]:
@@ -347,11 +373,12 @@ def main(argv: list[str] | None = None) -> int:
             atomic_write_text(spec3, three_d_spec(points, args.grid, args.transits_3d,
                                                   args.wall_3d))
             t0 = time.perf_counter()
-            done3 = run_batch(spec3, BatchOptions(out=work / "three_d", jobs=1, quiet=True,
-                                                  regime=False, report=None))
+            three_d = run(spec3, work / "three_d", args, jobs=1)
             record["three_d_wall_s"] = time.perf_counter() - t0
+            if three_d is None:
+                return 130
             rung3 = "3D coarse"
-            rows += point_rows(done3.batch_dir, lambda r: rung3)
+            rows += point_rows(three_d, lambda r: rung3)
             rungs.append(rung3)
             against[rung3] = f"thin-film {seed_level}"
             record["three_d_started_from"] = (f"thin-film {seed_level} state"
@@ -363,13 +390,15 @@ def main(argv: list[str] | None = None) -> int:
             s = next(t for t in table if t["rung"] == rung)
             draw(maps / f"stability_{rung.replace('thin-film ', 'tf_').replace(' ', '_')}.png",
                  rows, rung, f"{rung}: {s['points']} points, 40 C, 20 N, 90 kPa")
-    print(f"{len(rows)} points, {len(rungs)} rungs (load {load:.2f} at the start; thin-film "
-          f"batch {record['thin_film_wall_s']:.0f} s wall)")
+    ran = ("read only" if args.collect
+           else f"thin-film batch {record['thin_film_wall_s']:.0f} s wall")
+    print(f"{len(rows)} points, {len(rungs)} rungs (load {load:.2f} at the start; {ran})")
     print_table(table, [("rung", "rung", ""), ("points", "points", "d"),
                         ("rest I", "rest I", "d"), ("rest II", "rest II", "d"),
                         ("not at rest (end_time)", "end_time", "d"),
                         ("not at rest (wall_limit)", "wall_limit", "d"),
-                        ("failed", "failed", "d"), ("vs", "vs", ""),
+                        ("failed", "failed", "d"), ("not run", "not run", "d"),
+                        ("vs", "vs", ""),
                         ("flips", "flips", "d"), ("compared", "of", "d"),
                         ("max_d_inlet_meniscus_over_a", "max d inlet [a]", ".2f"),
                         ("max_d_flooded_width_over_a", "max d width [a]", ".2f"),
