@@ -41,6 +41,8 @@ def _plan(data: dict):
      ["case rampA_up01_u05.0", "has mesh.follow but no state to start from"]),
     ({"ramp": [{"name": "A", "contact.speed": []}]}, ["a ramp without speeds"]),
     ({"ramp": [{"name": "A", "contact.speed": [0.008, 0.005]}]}, ["strictly increasing"]),
+    ({"ramp": [{"name": "A", "contact.speed": [0.008]}]},
+     ["ramp[0]", "a ramp needs at least two speeds", "or a start_from"]),
     ({"ramp": [{"name": "A", "contact": {"speed": [0.005, 0.008], "temperature": 99}}]},
      ["ramp 'A': contact: temperature = 99 C", "valid range 25 to 60 C"]),
     ({"ramp": [{"name": "A", "contact.speed": [0.005, 0.008]},

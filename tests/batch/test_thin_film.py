@@ -88,3 +88,23 @@ def test_a_thin_film_batch_with_a_3d_key_or_a_bad_cell_is_refused_before_anythin
     assert batch_cli.main([str(spec), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     assert words in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_one_speed_ramp_is_one_case_started_from_a_thin_film_state(ran, tmp_path):
+    """A ramp of one speed with a start_from is one case seeded from that state (how a map's
+    points start from the thin-film state at the same point): it starts with the source's
+    oil and comes to rest sooner than the same case from the puddle."""
+    outcome, rows = ran
+    source = outcome.batch_dir / rows[9e4]["case_dir"]
+    spec = tmp_path / "seeded.toml"
+    spec.write_text(BATCH.split("[sweep]")[0] + "physics = { cavitation_pressure = 9e4 }\n"
+                    '[[ramp]]\nname = "P"\ncontact.speed = [0.02]\nbranches = "up"\n'
+                    f'start_from = "{source / "state.npz"}"\n')
+    seeded = run_batch(spec, BatchOptions(out=tmp_path / "seeded", jobs=1, quiet=True))
+    assert seeded.exit_code == 0 and sum(seeded.counts.values()) == 1
+    (case,) = (seeded.batch_dir / "cases").iterdir()
+    m = json.loads((case / "metrics.json").read_text())
+    src = json.loads((source / "metrics.json").read_text())
+    assert m["oil_volume_initial_m3"] == pytest.approx(src["oil_volume_m3"], rel=1e-6)
+    assert m["state"] == src["state"] == "I" and m["end_reason"] == "steady"
+    assert m["time_steps"] < src["time_steps"]

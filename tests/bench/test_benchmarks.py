@@ -4,6 +4,7 @@ tree, and the numbers it measured are the ones its model gives."""
 
 from __future__ import annotations
 
+import csv
 import json
 import subprocess
 import sys
@@ -159,3 +160,31 @@ def test_starved_film_follows_the_starvation_relations(tmp_path):
     assert point["worst_chevalier"] < 0.02 and 1.0 < point["gamma_fit"] < 10.0
     assert point["worst_hamrock_dowson"] < 0.06
     assert 1.0 < point["onset_m"] < point["m_star"] + 0.5
+
+
+@pytest.mark.slow
+def test_stability_maps_classify_every_point_and_compare_the_levels(tmp_path, tmp_path_factory):
+    maps = tmp_path_factory.mktemp("maps")
+    stdout, rec = run_bench("stability_maps", tmp_path, "--maps", str(maps))
+    rows = rec["rows"]
+    assert sorted((r["rung"], r["speed_m_s"]) for r in rows) == [
+        ("thin-film coarse", 0.045), ("thin-film coarse", 0.1),
+        ("thin-film medium", 0.045), ("thin-film medium", 0.1)]
+    medium = {r["speed_m_s"]: r for r in rows if r["rung"] == "thin-film medium"}
+    for r in rows:
+        assert r["status"] == "finished" and r["outcome"] == f"rest {r['state']}", r
+        assert r["cost_s"] > 0 and r["transits"] > 0 and r["failure_reason"] == ""
+        if r["rung"] == "thin-film coarse":   # each level against the next finer one
+            other = medium[r["speed_m_s"]]
+            assert r["vs"] == "thin-film medium" and r["vs_state"] == other["state"]
+            assert r["flips"] == (r["state"] != other["state"])
+            assert r["d_flooded_width_over_a"] == pytest.approx(
+                r["flooded_width_over_a"] - other["flooded_width_over_a"])
+            assert r["cells"] < other["cells"]
+    with open(maps / "stability.csv", newline="") as fh:
+        assert len(list(csv.DictReader(fh))) == len(rows)
+    assert sorted(p.name for p in maps.glob("*.png")) == ["stability_tf_coarse.png",
+                                                          "stability_tf_medium.png"]
+    (coarse, _) = rec["summary"]
+    assert coarse["points"] == 2 and coarse["rest I"] + coarse["rest II"] == 2
+    assert table_rows(stdout, "rung  points")[0][:3] == ["thin-film", "coarse", "2"]

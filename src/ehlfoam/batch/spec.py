@@ -28,6 +28,7 @@ A batch spec is a TOML file (``ehlfoam batch NAME.toml`` writes its cases under
     start_from = "runs/u8"             # optional: the first step starts from this run
                                        # case's final fields (a converged state), or from
                                        # the oil of a thin-film state (a .npz file)
+                                       # (with it, one speed is allowed: one seeded case)
 
 Any case-spec key may be swept: a list of values, a range of numbers ``{start, stop, num
 | step, spacing = "linear" | "log"}`` (stop included) or a single value; a table value (a
@@ -197,8 +198,6 @@ def _ramp_speeds(raw: Any, info: ValidationInfo) -> list[float]:
     bad = [v for v in values if not _number(v)]
     if bad:
         raise ValueError(f"{bad[0]!r} is not a number ({RANGE_HELP})")
-    if len(values) < 2:
-        raise ValueError("a ramp needs at least two speeds, e.g. [0.005, 0.008, 0.012]")
     if any(b <= a for a, b in zip(values, values[1:])):
         raise ValueError("ramp speeds must be strictly increasing (the way down is generated "
                          "by branches = \"up-down\")")
@@ -362,6 +361,14 @@ class Ramp(BaseModel):
         if "contact.speed" in flat:
             out["contact.speed"] = flat["contact.speed"]
         return {**out, "fixed": {**out.get("fixed", {}), **fixed}}
+
+    @model_validator(mode="after")
+    def _two_speeds_or_a_start(self) -> "Ramp":
+        if len(self.speeds) < 2 and self.start_from is None:   # one step: a seeded case
+            raise ValueError(f"contact.speed = {self.speeds}: a ramp needs at least two "
+                             f"speeds, e.g. [0.005, 0.008, 0.012], or a start_from (a ramp "
+                             f"of one speed is one case started from that run or state)")
+        return self
 
     def steps(self) -> list[tuple[float, str]]:
         """(speed [m/s], "up" | "down") in run order."""

@@ -23,11 +23,15 @@ TRUST = {
         "bubble is the gas-release scene's with an instant release (within 7 % of the 3D bath "
         "at 99 kPa); at six reference points its medium level is within 8 % of the finest "
         "rung at rest; a state within a speed step of the transition can flip with the grid "
-        "or the start (docs/ladder.md#speed-against-accuracy)."),
+        "or the start (docs/ladder.md#speed-against-accuracy). On the coarse grid (0.4 a) "
+        "bubbles read 8-12 % short and one under two cells (0.65 a at 2 mm/s) is missed; "
+        "rests from a puddle take 8-60 transits, longest at low speed and thick layers "
+        "(docs/models/stability.md)."),
     "coarse": (
         "3D coarse (minutes a case): a first look; the flooded width 17-21 % short of the "
-        "converged one, the inlet some 16 % upstream; a few transits are not a rest "
-        "(docs/ladder.md#speed-against-accuracy)."),
+        "converged one, the inlet some 16 % upstream; a few transits are not a rest: started "
+        "from the thin-film state it was still shedding oil after 1-6 transits at 5 of 6 "
+        "points of 4-21 mm/s (docs/models/stability.md, docs/ladder.md)."),
     "medium": (
         "3D medium: the default levels' width 17-21 % short of the converged one "
         "(docs/validation.md)."),
