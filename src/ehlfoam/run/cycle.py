@@ -32,7 +32,8 @@ import csv
 import io
 import signal
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -45,7 +46,7 @@ from ehlfoam.gap.field import GapField
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run.fields import Sample
 from ehlfoam.run.history import write_history
-from ehlfoam.run.thin_film import STATE_FILE, start_of
+from ehlfoam.run.thin_film import STATE_FILE, sigterm_interrupts, start_of
 from ehlfoam.run.thin_film_record import Accounts, sample, thin_film_record
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.cycle import rig_layers
@@ -122,7 +123,7 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
     reason, failure, period = None, None, None
     t_wall = time.monotonic()
     previous = signal.getsignal(signal.SIGTERM)
-    handled = _on_sigterm()
+    handled = sigterm_interrupts()
     try:
         while tracks.passes < spec.cycle.passes_max:
             t_pass = time.monotonic()
@@ -138,18 +139,19 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
             except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
                 failure = err
                 break
-            took, side = m.oil_in - took, m.oil_out_side - side0
-            s, before = sample(m, t0, geom, before)
-            history.append(s)
+            with _signals_held():   # a pass is booked whole: its tracks, row and files
+                took, side = m.oil_in - took, m.oil_out_side - side0
+                s, before = sample(m, t0, geom, before)
+                history.append(s)
+                arc = tracks.next_arc
+                tracks.lay(rig, m.oil_out_rows, side)
+                row = _row(tracks, rig, m, s, arc, took, float(m.oil_out_rows.sum()) + side,
+                           rig_initial, time.monotonic() - t_pass, inlet)
+                rows.append(row)
+                _save(path, rows, tracks, m)
+                write_history(path, history)
             if on_sample:
                 on_sample(s, geom)
-            arc = tracks.next_arc
-            tracks.lay(rig, m.oil_out_rows, side)
-            row = _row(tracks, rig, m, s, arc, took, float(m.oil_out_rows.sum()) + side,
-                       rig_initial, time.monotonic() - t_pass, inlet)
-            rows.append(row)
-            _save(path, rows, tracks, m)
-            write_history(path, history)
             if on_pass:
                 on_pass(row)
             reason, period = cycle_end(rows, rig.arcs, spec.cycle.tolerance,
@@ -192,6 +194,18 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
             f"{type(failure).__name__}: {failure}".split())[:500])
     write_metrics(path, record)
     return record
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """SIGTERM and SIGINT wait until the block is done (then interrupt as usual), so that an
+    interrupt never leaves a pass half booked: its row counted but its files not written."""
+    held = {signal.SIGTERM, signal.SIGINT}
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def cycle_end(rows: list[dict], arcs: int, tol: float, period_max: int
@@ -269,14 +283,3 @@ def _read_rows(path: Path) -> list[dict]:
         return []
     with open(path, newline="") as fh:
         return list(csv.DictReader(fh))
-
-
-def _on_sigterm() -> bool:
-    def interrupt(signum: int, frame: object) -> None:
-        raise KeyboardInterrupt
-    try:
-        signal.signal(signal.SIGTERM, interrupt)
-    except ValueError:
-        return False
-    return True
-

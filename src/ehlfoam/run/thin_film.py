@@ -49,7 +49,7 @@ from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state, save_state
 
-__all__ = ["STATE_FILE", "run_thin_film_case", "start_of"]
+__all__ = ["STATE_FILE", "run_thin_film_case", "sigterm_interrupts", "start_of"]
 
 #: the state a thin-film run ends with, in the case folder
 STATE_FILE = "state.npz"
@@ -125,7 +125,7 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
     reason, kind, failure = None, None, None
     t_wall = time.monotonic()
     previous = signal.getsignal(signal.SIGTERM)
-    handled = _on_sigterm()
+    handled = sigterm_interrupts()
     try:
         while m.steps < n_steps:
             try:
@@ -209,7 +209,7 @@ def _write_gas(path: Path, m: Marcher) -> None:
                         **{k: [2.0 * r[k] for r in m.history] for k in g.budget}}})
 
 
-def _on_sigterm() -> bool:
+def sigterm_interrupts() -> bool:
     """SIGTERM raises KeyboardInterrupt (the run ends ``interrupted``, its state written);
     False where signals cannot be set (not the main thread)."""
     def interrupt(signum: int, frame: object) -> None:
