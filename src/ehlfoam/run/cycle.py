@@ -42,15 +42,13 @@ from ehlfoam._io import atomic_write_text
 from ehlfoam.case.geometry import CaseGeometry, load_geometry, load_spec_of
 from ehlfoam.case.ownership import hold_run_lock
 from ehlfoam.errors import SpecError
-from ehlfoam.gap.field import GapField
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run.fields import Sample
 from ehlfoam.run.history import write_history
-from ehlfoam.run.thin_film import STATE_FILE, sigterm_interrupts, start_of
+from ehlfoam.run.thin_film import STATE_FILE, open_march, sigterm_interrupts
 from ehlfoam.run.thin_film_record import Accounts, sample, thin_film_record
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.cycle import rig_layers
-from ehlfoam.thinfilm.from_spec import problem_from_spec, scene_options
 from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.thinfilm.state import save_state
 from ehlfoam.tracks.rig import Rig, Tracks
@@ -104,11 +102,7 @@ def run_cycle_case(case: str | Path, *, wall_limit: float | None = None,
 
 def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
            on_sample, on_pass) -> MetricsRecord:
-    start, t0, history, initial = start_of(path)
-    write_metrics(path, MetricsRecord(status="running", cells=geom.cells))
-    prob = problem_from_spec(spec, GapField.load(path / "precalc"), scene_options(spec))
-    m = Marcher(prob, start=start, courant=spec.thin_film.courant,
-                transit_length=spec.run.transit_length * spec.a)
+    m, t0, history, initial = open_march(path, spec, geom)
     rig = rig_of(spec, m)
     rows = _read_rows(path / CYCLE_FILE)
     if (path / TRACKS_FILE).is_file() and rows:

@@ -49,7 +49,7 @@ from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state, save_state
 
-__all__ = ["STATE_FILE", "run_thin_film_case", "sigterm_interrupts", "start_of"]
+__all__ = ["STATE_FILE", "open_march", "run_thin_film_case", "sigterm_interrupts", "start_of"]
 
 #: the state a thin-film run ends with, in the case folder
 STATE_FILE = "state.npz"
@@ -108,13 +108,22 @@ def start_of(path: Path) -> tuple[ThinFilmSolution | None, float, list[Sample], 
     return None, 0.0, [], None
 
 
-def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
-                on_sample: OnSample | None, extend: float | None) -> MetricsRecord:
-    start, t0, history, initial = start_of(path)       # before metrics.json says running
+def open_march(path: Path, spec: CaseSpec, geom: CaseGeometry
+               ) -> tuple[Marcher, float, list[Sample], float | None]:
+    """The case's march from where it starts (:func:`start_of`, read before metrics.json
+    says running, which it then does): the marcher, the start's time [s], the samples before
+    it and the oil at t = 0 [m3] when known."""
+    start, t0, history, initial = start_of(path)
     write_metrics(path, MetricsRecord(status="running", cells=geom.cells))
     prob = problem_from_spec(spec, GapField.load(path / "precalc"), scene_options(spec))
     m = Marcher(prob, start=start, courant=spec.thin_film.courant,
                 transit_length=spec.run.transit_length * spec.a)
+    return m, t0, history, initial
+
+
+def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
+                on_sample: OnSample | None, extend: float | None) -> MetricsRecord:
+    m, t0, history, initial = open_march(path, spec, geom)
     end_time = t0 + extend * geom.transit_time if extend else spec.end_time
     n_steps = max(0, math.ceil((end_time - t0) / m.dt - 1e-6))
     write_every = max(1, round(m.steps_per_transit / spec.run.writes_per_transit))
