@@ -125,6 +125,36 @@ def test_a_stopped_cycle_goes_on_from_its_last_pass(built, tmp_path):
     assert again["oil_rig_balance_error"] < 1e-12
 
 
+def test_a_cycle_started_from_a_cycle_carries_its_tracks(built, tmp_path):
+    """A cycle started from a settled cycle's case (a ramp's step: `ehlfoam case
+    --start-from`) takes over the oil that cycle left on the tracks as well as its contact:
+    at the same speed its first pass takes in what the settled passes took, so it is periodic
+    in the fewest passes; at another speed the rig's oil is the first cycle's to round-off
+    (the uniform layers of the spec would hold another amount)."""
+    first = _copy(built, tmp_path)
+    done = run_case(first)
+    settled = _rows(first)
+    assert done["end_reason"] == "periodic" and len(settled) >= 4
+    for speed, name in ((0.02, "same"), (0.03, "faster")):
+        case = tmp_path / name
+        assert main(["case", "--out", str(case), *_set(RIG), "--set",
+                     f"contact.speed={speed}", "--start-from", str(first)]) == 0
+        ramp = json.loads((case / "ehlfoam" / "ramp.json").read_text())
+        assert ramp["fields"] == ["oil", "tracks"] and (case / "ehlfoam" /
+                                                         "start_tracks.npz").is_file()
+        m = run_case(case)
+        rows = _rows(case)
+        assert m["oil_rig_initial_m3"] == pytest.approx(done["oil_rig_m3"], rel=1e-12)
+        assert m["oil_rig_balance_error"] < 1e-12
+        if name == "same":
+            assert float(rows[0]["inlet_m3"]) == pytest.approx(
+                float(settled[-1]["inlet_m3"]), rel=1e-4)
+            assert m["end_reason"] == "periodic" and len(rows) == 3
+    # from the spec's uniform layers the first pass took another amount
+    assert float(settled[0]["inlet_m3"]) != pytest.approx(float(settled[-1]["inlet_m3"]),
+                                                          rel=1e-2, abs=0)
+
+
 def test_sigterm_ends_the_cycle_interrupted_and_it_goes_on_in_step(built, tmp_path):
     """SIGTERM mid-cycle: end reason interrupted, the passes made kept; the pass cut short is
     not written, so run again the cycle goes on with the next pass and the rig's oil is

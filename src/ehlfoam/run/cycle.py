@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from ehlfoam._io import atomic_write_text
-from ehlfoam.case.geometry import CaseGeometry, load_geometry, load_spec_of
+from ehlfoam.case.geometry import META, CaseGeometry, load_geometry, load_spec_of
 from ehlfoam.case.ownership import hold_run_lock
 from ehlfoam.errors import SpecError
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
@@ -53,10 +53,12 @@ from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.thinfilm.state import save_state
 from ehlfoam.tracks.rig import Rig, Tracks
 
-__all__ = ["CYCLE_FILE", "TRACKS_FILE", "cycle_end", "rig_of", "run_cycle_case"]
+__all__ = ["CYCLE_FILE", "START_TRACKS", "TRACKS_FILE", "cycle_end", "rig_of", "run_cycle_case"]
 
 #: in the case folder: a row a pass, and the tracks' layers after the last pass
 CYCLE_FILE, TRACKS_FILE = "cycle.csv", "tracks.npz"
+#: in the case's ehlfoam/: the tracks a cycle started from another's begins with
+START_TRACKS = "start_tracks.npz"
 
 OnPass = Callable[[dict], None]
 
@@ -109,7 +111,7 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
         tracks = Tracks.load(path / TRACKS_FILE)
         rig_initial = float(rows[0]["oil_rig_initial_m3"])
     else:
-        tracks = Tracks.uniform(rig, *rig_layers(spec), spec.supply.track_half_width)
+        tracks = _start_tracks(path, spec, rig)
         rows, history = [], []
         rig_initial = 2.0 * (sum(tracks.oil(rig)) + m.oil())
     first = before = Accounts.of(m, t0)
@@ -188,6 +190,25 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
             f"{type(failure).__name__}: {failure}".split())[:500])
     write_metrics(path, record)
     return record
+
+
+def _start_tracks(path: Path, spec: CaseSpec, rig: Rig) -> Tracks:
+    """The tracks the cycle starts from: those of the cycle it was started from (a ramp's
+    previous step, at another speed: the layers and the arc met next kept, the passes counted
+    anew), else the spec's uniform layers. ValueError if the carried tracks do not fit this
+    rig (another contact grid or track radius)."""
+    carried = path / META / START_TRACKS
+    if not carried.is_file():
+        return Tracks.uniform(rig, *rig_layers(spec), spec.supply.track_half_width)
+    tracks = Tracks.load(carried)
+    want = (rig.arcs, rig.width_rows)
+    if tracks.disc.shape != want or tracks.ball.shape != want[1:]:
+        raise ValueError(f"the tracks this cycle starts from ({carried}) hold "
+                         f"{tracks.disc.shape[0]} arcs x {tracks.disc.shape[1]} rows, this "
+                         f"rig {want[0]} x {want[1]}: a cycle carries its tracks only to one "
+                         "of the same contact grid, track radius and cycle.side")
+    tracks.passes = 0
+    return tracks
 
 
 @contextmanager

@@ -5,7 +5,9 @@ A thin-film case starts from the oil of a state the model wrote: a ``state.npz``
 thin-film case's run, or of ``ehlfoam thin-film``), or a thin-film case folder that has run
 (its ``state.npz``), on any grid; the march interpolates it onto its own
 (:class:`~ehlfoam.thinfilm.march.Marcher`). The state is copied into the case
-(``ehlfoam/start.npz``), so that the case runs by itself. A 3D case or snapshot cannot start
+(``ehlfoam/start.npz``), so that the case runs by itself. A cycle of passes (``supply.mode =
+"rig"``) started from a cycle's case also takes over the oil that cycle left on the tracks
+(``ehlfoam/start_tracks.npz``): a ramp's step carries the rig's state to the next speed. A 3D case or snapshot cannot start
 one: the model's oil is not a 3D field. A 3D case starts from a thin-film case folder as from
 its ``state.npz`` (:mod:`ehlfoam.seed.thin_film`).
 """
@@ -20,9 +22,10 @@ from typing import Any
 import numpy as np
 
 from ehlfoam._io import atomic_write_json
-from ehlfoam.case.geometry import META, load_geometry
+from ehlfoam.case.geometry import META, load_geometry, load_spec_of
 from ehlfoam.case.thin_film import START, is_thin_film_case
 from ehlfoam.gap.field import GapField
+from ehlfoam.run.cycle import START_TRACKS, TRACKS_FILE
 from ehlfoam.run.thin_film import STATE_FILE
 from ehlfoam.seed.write import GAP_TOLERANCE, RampError
 from ehlfoam.thinfilm.state import load_state
@@ -83,5 +86,16 @@ def seed_thin_film_case(case: str | Path, source: str | Path) -> dict[str, Any]:
     info = {"previous": os.path.relpath(state, case), "previous_time_s": sol.time,
             "method": "thin-film state", "fields": ["oil"],
             "cells": load_geometry(case).cells, "gap_difference": off}
+    tracks = state.parent / TRACKS_FILE
+    if _is_rig(case) and state.name == STATE_FILE and tracks.is_file():
+        shutil.copyfile(tracks, case / META / f".{START_TRACKS}.tmp")
+        os.replace(case / META / f".{START_TRACKS}.tmp", case / META / START_TRACKS)
+        info["tracks"] = os.path.relpath(tracks, case)
+        info["fields"] = ["oil", "tracks"]
     atomic_write_json(case / META / "ramp.json", info)
     return info
+
+
+def _is_rig(case: Path) -> bool:
+    """The case takes its supply from the oil on the rig (a cycle of passes)."""
+    return load_spec_of(case).supply.mode == "rig"
