@@ -249,6 +249,15 @@ class MetricsRecord(BaseModel):
     oil_rig_balance_error: float | None = _key(
         "The rig's oil now less at the start, over at the start (round-off: nothing is "
         "added or lost)", "1", "Rig oil balance error", "%", 100.0)
+    hc_over_hc_flooded: float | None = _key(
+        "The contact's central film over the fully flooded one, its inlet meniscus where the "
+        "settled cycle's last passes put it (the starved EHL precalc on the contact's grid)",
+        "1",
+        "Central film / flooded film (hc / hc,ff)", "%", 100.0)
+    starved_meniscus_over_a: float | None = _key(
+        "The inlet meniscus distance from x = -a the starved film was solved at: the mean "
+        "of the cycle's last passes, rounded to 0.05 a and held within 0.05-3 a", "a",
+        "Inlet meniscus of the starved film")
     # ---------------------------------------------------------------- the run's cost, mesh
     cells: int | None = _text("Cells of the mesh", "Cells")
     time_steps: int | None = _text("Time steps the solver took", "Time steps")

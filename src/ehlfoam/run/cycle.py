@@ -22,7 +22,8 @@ its balance), the contact's ``state.npz`` and the tracks' ``tracks.npz``: a cycl
 stopped goes on from its last pass when run again, nothing lost (a pass cut short is made
 again: its state is not written, so the contact's and the tracks' oil stay in step). ``metrics.json`` holds the
 last pass's flow pattern (the thin-film run's keys) and the cycle's summary (``cycle_*``,
-``oil_rig_*`` keys). Volumes are the whole contact's and the whole tracks' (twice the half
+``oil_rig_*`` keys) and the contact's film at the settled passes' inlet meniscus
+(``hc_over_hc_flooded``, :func:`settled_film`). Volumes are the whole contact's and the whole tracks' (twice the half
 width marched).
 """
 
@@ -42,6 +43,7 @@ from ehlfoam._io import atomic_write_text
 from ehlfoam.case.geometry import META, CaseGeometry, load_geometry, load_spec_of
 from ehlfoam.case.ownership import hold_run_lock
 from ehlfoam.errors import SpecError
+from ehlfoam.gap.starved import starved_film
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run.fields import Sample
 from ehlfoam.run.history import write_history
@@ -53,7 +55,8 @@ from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.thinfilm.state import save_state
 from ehlfoam.tracks.rig import Rig, Tracks
 
-__all__ = ["CYCLE_FILE", "START_TRACKS", "TRACKS_FILE", "cycle_end", "rig_of", "run_cycle_case"]
+__all__ = ["CYCLE_FILE", "START_TRACKS", "TRACKS_FILE", "cycle_end", "rig_of", "run_cycle_case",
+           "settled_film"]
 
 #: in the case folder: a row a pass, and the tracks' layers after the last pass
 CYCLE_FILE, TRACKS_FILE = "cycle.csv", "tracks.npz"
@@ -185,11 +188,24 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
         oil_disc_track_m3=2.0 * disc, oil_ball_track_m3=2.0 * ball, oil_rig_m3=rig_now,
         oil_rig_initial_m3=rig_initial,
         oil_rig_balance_error=abs(rig_now - rig_initial) / rig_initial)
+    if reason not in ("diverged", "interrupted"):
+        record = record.updated(**settled_film(spec, rows, rig.arcs))
     if failure is not None:
         record = record.updated(reason="the march failed: " + " ".join(
             f"{type(failure).__name__}: {failure}".split())[:500])
     write_metrics(path, record)
     return record
+
+
+def settled_film(spec: CaseSpec, rows: list[dict], arcs: int) -> dict:
+    """The contact's film at the inlet meniscus of the cycle's last max(K, 2) passes (their
+    mean; :func:`ehlfoam.gap.starved.starved_film` on the contact's grid: hc / hc,ff on 257^2
+    is within 1 % of the default grid's at the reference conditions, docs/models/
+    supply-cycle.md)."""
+    last = [float(r["inlet_meniscus_distance_over_a"]) for r in rows[-max(arcs, 2):]
+            if r.get("inlet_meniscus_distance_over_a") not in (None, "")]
+    meniscus = float(np.mean(last)) if last else None
+    return starved_film(spec.contact, meniscus)
 
 
 def _start_tracks(path: Path, spec: CaseSpec, rig: Rig) -> Tracks:
