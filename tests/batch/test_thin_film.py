@@ -108,3 +108,49 @@ def test_a_one_speed_ramp_is_one_case_started_from_a_thin_film_state(ran, tmp_pa
     assert m["oil_volume_initial_m3"] == pytest.approx(src["oil_volume_m3"], rel=1e-6)
     assert m["state"] == src["state"] == "I" and m["end_reason"] == "steady"
     assert m["time_steps"] < src["time_steps"]
+
+
+RIG_RAMP = """
+name = "rig"
+[base]
+scene = "thin-film"
+contact = { speed = 0.02, grid = 129, tol_residual = 1e-4 }
+domain = { upstream = 3.5, downstream = 5.5, side = 4.0 }
+supply = { mode = "rig", disc_layer = 1e-6, ball_layer = 1e-6, track_half_width = 2.5e-4, initial_puddle = 2.5, track_radius = 1.3e-3 }
+physics = { cavitation_pressure = 9e4 }
+thin_film = { cell = 0.9, courant = 1.0, normal_length = 0.9 }
+cycle = { passes_max = 6, tolerance = 1e-6, reflow_steps = 8, refine = 1, side = 6.0 }
+[[ramp]]
+name = "R"
+contact.speed = [0.02, 0.03]
+branches = "up-down"
+"""
+
+
+def test_a_ramp_of_cycles_carries_the_rig_s_oil_from_step_to_step(tmp_path):
+    """A speed ramp of rig cases (issue 75): each step's cycle starts from the contact and the
+    tracks the step before left, so the rig's oil at each step's start is the first step's
+    to round-off; results.csv has the steps' states and films, regime.json the ramp."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("EHLFOAM_FOAM", "prefix")
+    mp.setenv("EHLFOAM_FOAM_PREFIX", "/bin/false")
+    try:
+        spec = tmp_path / "rig.toml"
+        spec.write_text(RIG_RAMP)
+        outcome = run_batch(spec, BatchOptions(out=tmp_path / "rig", jobs=1, quiet=True))
+    finally:
+        mp.undo()
+    assert outcome.exit_code == 0
+    with open(outcome.batch_dir / "results.csv", newline="") as fh:
+        rows = sorted(csv.DictReader(fh), key=lambda r: int(r["ramp_step"]))
+    assert [r["ramp_direction"] for r in rows] == ["up", "up", "down"]
+    oil = [float(r["oil_rig_initial_m3"]) for r in rows]
+    assert oil[1:] == pytest.approx([oil[0]] * 2, rel=1e-12)
+    for r in rows[1:]:
+        ramp = json.loads((outcome.batch_dir / r["case_dir"] / "ehlfoam" / "ramp.json")
+                          .read_text())
+        assert ramp["fields"] == ["oil", "tracks"]
+    assert all(r["state"] in ("I", "II") and 0.3 < float(r["hc_over_hc_flooded"]) <= 1.01
+               for r in rows)
+    regime = json.loads((outcome.batch_dir / "regime" / "regime.json").read_text())
+    assert [rp["name"] for rp in regime["ramps"]] == ["R"]
