@@ -290,3 +290,32 @@ def test_a_batch_over_rig_cases_keeps_the_rig_supply(tmp_path):
     assert plan[0].params["supply.disc_layer"] == 0.6e-6
     layers = make_case_spec(plan[0].spec.model_dump(), **{"supply.mode": "layers"})
     assert est_cpu_s(plan[0].spec) > 10 * est_cpu_s(layers)
+
+
+def test_a_settled_cycle_is_confirmed_in_3d_at_the_supply_it_settled_on(built, tmp_path):
+    """A rig map's 3D confirmation (ehlfoam.batch.confirm) takes in, as a "layers" supply,
+    the band of oil the tracks bring the contact's rows after the cycle's last pass: the
+    same oil on those rows, the rig-only keys and the cycle left behind."""
+    from ehlfoam.batch.confirm import confirm_spec
+    from ehlfoam.batch.spec import BatchSpec
+    from ehlfoam.case.geometry import load_spec_of
+    from ehlfoam.run.cycle import settled_supply
+    from ehlfoam.thinfilm.state import load_state
+
+    case = _copy(built, tmp_path)
+    run_case(case)
+    band = settled_supply(case)
+    tracks, grid = Tracks.load(case / "tracks.npz"), load_state(case / "state.npz").grid
+    rows = len(grid.y)
+    inlet = tracks.disc[tracks.next_arc, :rows].sum() * grid.cell
+    width = band["supply.track_half_width"] - band["supply.track_inner_half_width"]
+    assert band["supply.disc_layer"] * width == pytest.approx(inlet, rel=1e-12)
+    assert 0 < width <= rows * grid.cell
+    batch = BatchSpec.model_validate({"base": {}, "sweep": [{"contact.speed": [0.02]}],
+                                      "confirm": {"rung": "coarse"}})
+    spec = confirm_spec(batch, load_spec_of(case), band)
+    assert (spec.scene, spec.supply.mode) == ("gas-release", "layers")
+    assert spec.supply.disc_layer == pytest.approx(band["supply.disc_layer"])
+    assert spec.supply.track_half_width == pytest.approx(band["supply.track_half_width"])
+    start = confirm_spec(batch, load_spec_of(case))            # before the map: the start's
+    assert start.supply.disc_layer == pytest.approx(1e-6)

@@ -9,6 +9,12 @@ state II above it) are run again on a 3D rung (``confirm.rung``, the scene
 (``confirms``), and the regime analysis whether the two rungs agree on the state
 (:func:`ehlfoam.batch.regime.confirmations`). The plan of the confirmations follows from the
 finished map alone, so a batch that resumes finds the same cases and keeps those that ran.
+
+A map of cycles (``supply.mode = "rig"``) is confirmed at the supply each cycle settled on:
+the 3D case takes in, as a "layers" supply, the band of oil the tracks bring the contact's
+rows after the cycle's last pass (:func:`ehlfoam.run.cycle.settled_supply`; a dry middle
+where the tracks have one), started from the cycle's contact. It checks the state the
+settled supply gives, not the cycle itself (a 3D cycle of passes would take days).
 """
 
 from __future__ import annotations
@@ -20,7 +26,9 @@ from ehlfoam.batch.plan import PARAM_KEYS, PlannedCase, case_id, value_of
 from ehlfoam.batch.regime import analyse, row_rung, row_supply
 from ehlfoam.batch.spec import BatchSpec
 from ehlfoam.errors import SpecError
+from ehlfoam.run.cycle import settled_supply
 from ehlfoam.spec.case import CaseSpec, make_case_spec
+from ehlfoam.spec.cycle import rig_layers
 
 __all__ = ["PREFIX", "check_confirm", "confirm_plan", "confirm_spec"]
 
@@ -28,16 +36,33 @@ __all__ = ["PREFIX", "check_confirm", "confirm_plan", "confirm_spec"]
 PREFIX = "confirm_"
 
 
-def confirm_spec(batch: BatchSpec, thin_film: CaseSpec) -> CaseSpec:
+def confirm_spec(batch: BatchSpec, thin_film: CaseSpec,
+                 settled: dict[str, float] | None = None) -> CaseSpec:
     """The 3D case of a thin-film case's point: its contact, supply, oil, pressures and
     domain on ``confirm.rung`` in ``confirm.scene`` with ``confirm.set`` on top (the
-    thin-film case's grid and run limits are the model's own and are left behind). Raises
-    :class:`SpecError`."""
+    thin-film case's grid and run limits are the model's own and are left behind). A cycle's
+    supply becomes the "layers" supply ``settled`` (dotted supply keys; none: the tracks'
+    layers at the cycle's start). Raises :class:`SpecError`."""
     conf = batch.confirm
     data = thin_film.to_toml_dict()
-    for key in ("rung", "scene", "mesh", "run", "name"):
+    for key in ("rung", "scene", "mesh", "run", "name", "cycle"):
         data.pop(key, None)
+    if thin_film.supply.mode == "rig":
+        data["supply"] = _layers(data["supply"], settled or _start_band(thin_film))
     return make_case_spec(data, rung=conf.rung, scene=conf.scene, **conf.set)
+
+
+def _start_band(spec: CaseSpec) -> dict[str, float]:
+    """A cycle's tracks at its start as a "layers" supply (dotted keys)."""
+    disc, ball = rig_layers(spec)
+    return {"supply.disc_layer": disc, "supply.ball_layer": ball}
+
+
+def _layers(supply: dict, band: dict[str, float]) -> dict:
+    """A "rig" supply table as the "layers" one of ``band`` (its rig-only keys dropped)."""
+    out = {k: v for k, v in supply.items()
+           if k not in ("disc_oil", "ball_oil", "track_radius")}
+    return {**out, "mode": "layers", **{k.split(".", 1)[1]: v for k, v in band.items()}}
 
 
 def check_confirm(batch: BatchSpec, plan: list[PlannedCase]) -> None:
@@ -70,7 +95,9 @@ def confirm_plan(batch: BatchSpec, plan: list[PlannedCase], rows: list[dict],
             tf = by_id[row["case_id"]]
             if any(value_of(tf.spec, k) != v for k, v in batch.confirm.only.items()):
                 continue
-            spec = _spec_of(batch, tf)
+            settled = settled_supply(batch_dir / CASES / tf.id) \
+                if tf.spec.supply.mode == "rig" else None
+            spec = _spec_of(batch, tf, settled)
             cid = PREFIX + case_id(spec)
             ramp = {"start_from": str(batch_dir / CASES / tf.id), "confirms": tf.id}
             params = {k: value_of(spec, k) for k in PARAM_KEYS}
@@ -88,9 +115,10 @@ def _same(row: dict, line: dict, speed: float) -> bool:
         return False
 
 
-def _spec_of(batch: BatchSpec, tf: PlannedCase) -> CaseSpec:
+def _spec_of(batch: BatchSpec, tf: PlannedCase,
+             settled: dict[str, float] | None = None) -> CaseSpec:
     try:
-        return confirm_spec(batch, tf.spec)
+        return confirm_spec(batch, tf.spec, settled)
     except SpecError as err:
         raise SpecError(f"invalid batch spec: confirm: the 3D case of {tf.id}: "
                         f"{str(err).removeprefix('invalid case spec: ')}") from None

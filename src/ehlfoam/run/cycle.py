@@ -52,11 +52,11 @@ from ehlfoam.run.thin_film_record import Accounts, sample, thin_film_record
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.cycle import rig_layers
 from ehlfoam.thinfilm.march import Marcher
-from ehlfoam.thinfilm.state import save_state
-from ehlfoam.tracks.rig import Rig, Tracks
+from ehlfoam.thinfilm.state import load_state, save_state
+from ehlfoam.tracks.rig import Rig, Tracks, equivalent_band
 
 __all__ = ["CYCLE_FILE", "START_TRACKS", "TRACKS_FILE", "cycle_end", "rig_of", "run_cycle_case",
-           "settled_film"]
+           "settled_film", "settled_supply"]
 
 #: in the case folder: a row a pass, and the tracks' layers after the last pass
 CYCLE_FILE, TRACKS_FILE = "cycle.csv", "tracks.npz"
@@ -206,6 +206,18 @@ def settled_film(spec: CaseSpec, rows: list[dict], arcs: int) -> dict:
             if r.get("inlet_meniscus_distance_over_a") not in (None, "")]
     meniscus = float(np.mean(last)) if last else None
     return starved_film(spec.contact, meniscus)
+
+
+def settled_supply(case: str | Path) -> dict[str, float]:
+    """The supply a cycle's case settled on, as the 3D scenes' "layers" supply (dotted
+    case-spec keys, SI): the layers the tracks bring the contact's rows next pass (its state's
+    rows), as the uniform band that carries their oil (:func:`ehlfoam.tracks.rig.
+    equivalent_band`: a dry middle where the tracks have one). OSError, ValueError where the
+    case has not run a pass."""
+    case = Path(case)
+    tracks, grid = Tracks.load(case / TRACKS_FILE), load_state(case / STATE_FILE).grid
+    rows = len(grid.y)
+    return equivalent_band(tracks.disc[tracks.next_arc, :rows], tracks.ball[:rows], grid.cell)
 
 
 def _start_tracks(path: Path, spec: CaseSpec, rig: Rig) -> Tracks:

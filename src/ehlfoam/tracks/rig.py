@@ -35,7 +35,7 @@ from ehlfoam._io import atomic_write
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.tracks.reflow import reflow
 
-__all__ = ["Rig", "Tracks", "outlet_layers"]
+__all__ = ["Rig", "Tracks", "equivalent_band", "outlet_layers"]
 
 
 @dataclass(frozen=True)
@@ -233,3 +233,24 @@ def outlet_layers(sol: ThinFilmSolution, disc_share: float = 0.5
                          "not from its state (or move the outlet out: domain.downstream)")
     c = np.clip(sol.content[:, -1], 0.0, None)
     return disc_share * c, (1.0 - disc_share) * c
+
+
+def equivalent_band(disc: np.ndarray, ball: np.ndarray, row: float, share: float = 0.01
+                    ) -> dict[str, float]:
+    """The uniform band that carries the oil of the layers ``disc``, ``ball`` [m] on the rows
+    y = row (i + 1/2), i = 0, 1, ... (half width; row [m]): the 3D scenes' "layers" supply
+    (dotted case-spec keys, SI). Its edges are where the oil of both walls together, summed
+    from y = 0, reaches ``share`` (the inner edge of a dry middle, ``track_inner_half_width``,
+    0 when the middle carries oil) and 1 - ``share`` (``track_half_width``), each to a row's
+    edge; its layers hold each wall's oil over that width. ValueError without oil."""
+    disc, ball = np.clip(np.asarray(disc, float), 0, None), np.clip(np.asarray(ball, float), 0, None)
+    total = disc + ball
+    if not total.sum() > 0:
+        raise ValueError("the tracks carry no oil onto the contact's rows")
+    cum = np.cumsum(total) / total.sum()
+    inner = row * int(np.searchsorted(cum, share, side="right"))
+    outer = row * (int(np.searchsorted(cum, 1.0 - share)) + 1)
+    width = outer - inner
+    return {"supply.disc_layer": float(disc.sum()) * row / width,
+            "supply.ball_layer": float(ball.sum()) * row / width,
+            "supply.track_half_width": outer, "supply.track_inner_half_width": inner}
