@@ -41,8 +41,9 @@ def starved_film(contact: PrecalcSpec, meniscus_over_a: float | None) -> dict[st
     if meniscus_over_a is None or not abs(meniscus_over_a) < float("inf"):
         return none
     lo, hi = MENISCUS_RANGE
-    d = round(min(max(float(meniscus_over_a), lo), hi) / MENISCUS_STEP) * MENISCUS_STEP
-    spec = contact.model_copy(update={"inlet_meniscus": round(d, 6), "inlet_layer": None})
+    d = round(round(min(max(float(meniscus_over_a), lo), hi) / MENISCUS_STEP)
+              * MENISCUS_STEP, 6)
+    spec = contact.model_copy(update={"inlet_meniscus": d, "inlet_layer": None})
     try:
         folder = precalc_dir(spec)
     except PrecalcFailed:
