@@ -214,7 +214,7 @@ def _report_case(case_dir: str | os.PathLike, animate: bool, gif_frames: int) ->
     settle = steps.run("history chart", _history, info, out, page)
     if animate and fields is not None and not thin:
         steps.run("transient GIF", _gif, info, fields, out, page, gif_frames)
-    if thin and info.geom is not None and getattr(info.spec, "stop", None) is not None \
+    if animate and thin and info.geom is not None and info.spec is not None \
             and info.spec.stop.at is not None:
         steps.run("stop GIF", _stop, info, out, page)
     if summary_top:

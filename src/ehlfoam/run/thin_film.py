@@ -146,7 +146,7 @@ class _Frames:
         self.folder.mkdir(exist_ok=True)
 
     def after_step(self, m: Marcher) -> None:
-        """Write a frame when the step reached the next frame's time."""
+        """Write a frame when the march reached the next frame's time."""
         if self.on and self.t0 + m.time >= self.first + self.k * self.every - 1e-12:
             save_state(m.solution(), self.folder / f"{self.k:04d}.npz")
             self.k += 1
@@ -161,6 +161,7 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
     window = spec.thin_film.steady_window * geom.transit_time
     log = _Log(path / geom.log_name, spec, geom, m, t0)
     frames = _Frames(path, spec, t0)
+    frames.after_step(m)      # the start, when it is a frame's time
     stopping = spec.stop.at is not None   # runs to its end: no steady-state test
     first = before = Accounts.of(m, t0)
     oil_start = m.oil()
