@@ -45,9 +45,10 @@ def test_the_stop_table_is_checked_and_sets_the_run_s_end():
         make_case_spec({**tf, "stop": {"at": 0.0, "duration": -0.001}})
     with pytest.raises(SpecError, match=r"stop\.after = 0.*0 < stop\.after <= 100 s"):
         make_case_spec({**tf, "stop": {"at": 0.0, "after": 0.0}})
-    with pytest.raises(SpecError, match=r"stop\.at = 0\.02 s does not apply to scene = "
-                                        r"'interface'"):
-        make_case_spec({"stop": {"at": 0.02}})
+    assert make_case_spec({"stop": {"at": 0.02}}).end_time == pytest.approx(0.125)   # 3D
+    with pytest.raises(SpecError, match=r"stop\.at = 0\.02 s does not apply to supply\.mode "
+                                        r"= \"rig\""):
+        make_case_spec({**tf, "stop": {"at": 0.02}, "supply": {"mode": "rig"}})
     with pytest.raises(SpecError, match=r"run\.end_time = 1 s does not apply with stop\.at"):
         make_case_spec({**tf, "run": {"end_time": 1.0}})
 

@@ -99,8 +99,8 @@ class CaseSpec(BaseModel):
                                               'the tracks\' reflow and when the cycle ends '
                                               '(the other supply modes ignore it).')
     stop: Stop = Field(Stop(), description='The walls\' stop: from contact.speed to rest '
-                                           'over stop.duration from stop.at (scene = '
-                                           '"thin-film"; none: they roll throughout).')
+                                           'over stop.duration from stop.at (every scene; '
+                                           'unset: they roll throughout).')
 
     @model_validator(mode="before")
     @classmethod
@@ -278,6 +278,7 @@ def thin_film_counterpart(spec: CaseSpec, level: str = THIN_FILM_START["resoluti
     if spec.mesh.follow is not None or str(spec.rung).startswith("resolved-"):
         data["physics"].pop("contact_angle", None)   # the wall's, at the slip's scale: the
         # model's menisci hold the static angle (docs/ladder.md)
+    data.pop("stop", None)   # the start is the balance at speed, before any stop
     data.update(scene="thin-film", rung=f"thin-film-{level}", mesh={},
                 run={"transits_max": transits_max, "wall_limit": spec.run.wall_limit})
     try:

@@ -5,8 +5,9 @@ The walls roll at ``contact.speed`` until ``stop.at`` [s, run time], slow linear
 over ``stop.duration`` [s] and stay at rest; the run goes on ``stop.after`` [s] past rest
 (its end time, in place of ``run.end_time`` / ``run.transits_max``) and keeps a frame of its
 state every ``stop.frame_interval`` [s] from ``stop.frames_from`` before the stop on (the
-report's GIF). Without ``stop.at`` the walls roll at u throughout. Only the thin-film scene
-reads the table so far (:func:`check_stop`). SI units.
+report's GIF). Without ``stop.at`` the walls roll at u throughout. The thin-film scene's march
+follows it step by step (:mod:`ehlfoam.thinfilm.march`), the 3D scenes' boundary conditions as
+tables of time (:mod:`ehlfoam.case.stop`). SI units.
 """
 
 from __future__ import annotations
@@ -50,7 +51,9 @@ class Stop(BaseModel):
     frame_interval: float = Field(
         0.002, gt=0.0, le=1.0,
         description="A frame of the state (DIR/frames/, the report's GIF) every this much "
-                    "run time from frames_from before the stop to the end.",
+                    "run time from frames_from before the stop to the end (the thin-film "
+                    "scene; a 3D case writes its fields run.writes_per_transit times a "
+                    "transit, which its report animates).",
         json_schema_extra={"unit": "s"})
     frames_from: float = Field(
         0.01, ge=0.0, le=100.0,
@@ -78,21 +81,28 @@ def stop_end_time(stop: Stop) -> float | None:
 
 
 def check_stop(spec: CaseSpec) -> None:
-    """Refuse (:class:`SpecError`) a stop in a scene that does not read it (the 3D scenes,
-    whose walls' velocity is fixed in their templates), a stop with ``run.end_time`` (the
-    stop sets the end) and with still walls."""
+    """Refuse (:class:`SpecError`) a stop with ``run.end_time`` (the stop sets the end), with
+    still walls, in a cycle of passes (``supply.mode = "rig"``) and, in the 3D scenes, with
+    a Navier slip on the walls (``physics.wall_slip_length``: its face velocities are not
+    written to follow the stop)."""
     stop = spec.stop
     if stop.at is None:
         return
-    if spec.scene != "thin-film":
-        raise SpecError(f"invalid case spec: stop.at = {stop.at:g} s does not apply to scene "
-                        f"= {spec.scene!r} (valid: scene = \"thin-film\"; the 3D scenes' "
-                        "walls roll at contact.speed throughout: leave stop.at unset)")
+    problems = []
     if spec.run.end_time is not None:
-        raise SpecError(f"invalid case spec: run.end_time = {spec.run.end_time:g} s does not "
-                        f"apply with stop.at = {stop.at:g} s (the run ends stop.after = "
-                        f"{stop.after:g} s past rest: leave run.end_time unset)")
+        problems.append(f"run.end_time = {spec.run.end_time:g} s does not apply with stop.at "
+                        f"= {stop.at:g} s (the run ends stop.after = {stop.after:g} s past "
+                        "rest: leave run.end_time unset)")
+    if not spec.walls_moving:
+        problems.append(f"stop.at = {stop.at:g} s needs walls_moving = true (still walls "
+                        "have nothing to stop)")
     if spec.supply.mode == "rig":
-        raise SpecError(f"invalid case spec: stop.at = {stop.at:g} s does not apply to "
-                        "supply.mode = \"rig\" (a cycle of passes; valid: \"layers\" or "
-                        "\"flooded\")")
+        problems.append(f"stop.at = {stop.at:g} s does not apply to supply.mode = \"rig\" (a "
+                        "cycle of passes; valid: \"layers\", \"flooded\" or \"submerged\")")
+    if spec.scene != "thin-film" and spec.physics.wall_slip_length > 0:
+        problems.append(f"stop.at = {stop.at:g} s does not apply with "
+                        f"physics.wall_slip_length = {spec.physics.wall_slip_length:g} m in "
+                        f"scene = {spec.scene!r} (the slip walls' velocities do not follow "
+                        "the stop; valid: 0 m)")
+    if problems:
+        raise SpecError("invalid case spec: " + "; ".join(problems))
