@@ -9,9 +9,11 @@ from pathlib import Path
 import numpy as np
 from foamlib import FoamFieldFile
 
+from ehlfoam._io import atomic_write_text
 from ehlfoam.case import face_oil
 from ehlfoam.case.foam_lists import fill_placeholders, placeholder
 from ehlfoam.case.geometry import CaseGeometry
+from ehlfoam.case.stop import stop_entries, write_boundary_data
 from ehlfoam.case.wall_slip import navier_slip, rolling_velocity, wall_normals, write_slip_walls
 from ehlfoam.mesh import PolyMesh, split_patch
 from ehlfoam.spec.case import CaseSpec
@@ -163,11 +165,43 @@ def edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, fraction: np.ndarray
         fill_placeholders(case / "0.orig" / "alpha.oil", {placeholder("supply", "value"): supply})
     if spec.physics.wall_slip_length > 0:
         write_slip_walls(case / "0.orig" / "U", slip_walls(spec, mesh, u))
+    if spec.stop.at is not None:
+        _stop_walls(spec, case, mesh, supply_u)
     if not geom.symmetric:
         with FoamFieldFile(case / "0.orig" / "p_rgh") as f:
             del f.boundary_field["symmetry"]
     if spec.scene == "cavitating":
         _edit_thermo_fields(spec, case, geom)
+
+
+def _stop_walls(spec: CaseSpec, case: Path, mesh: PolyMesh, supply_u: np.ndarray) -> None:
+    """The walls' velocities as the stop has them over time (:mod:`ehlfoam.case.stop`): the
+    disc's and a uniform supply's as tables, the ball's omega as one, the island's and a
+    supply's of differing faces mapped from boundaryData."""
+    tables = stop_entries(spec)
+    mapped = {"island": island_velocity(spec, mesh)}
+    words = {"disc": tables["disc"]}
+    if np.ndim(supply_u) == 1:
+        words["supply"] = tables["disc"]
+    elif len(supply_u):
+        mapped["supply"] = supply_u
+    with FoamFieldFile(case / "0.orig" / "U") as f:
+        for patch in words:
+            f.boundary_field[patch]["type"] = "uniformFixedValue"
+            f.boundary_field[patch]["uniformValue"] = placeholder(patch, "uniformValue")
+        f.boundary_field["ball"]["omega"] = placeholder("ball", "omega")
+        for patch in mapped:
+            f.boundary_field[patch]["type"] = "timeVaryingMappedFixedValue"
+            f.boundary_field[patch]["mapMethod"] = "nearest"
+            f.boundary_field[patch]["setAverage"] = False
+    text = (case / "0.orig" / "U").read_text()
+    for word, table in [(placeholder(p, "uniformValue"), t) for p, t in words.items()] + [
+            (placeholder("ball", "omega"), tables["ball"])]:
+        text = text.replace(word, table)
+    atomic_write_text(case / "0.orig" / "U", text)
+    for patch, values in mapped.items():
+        write_boundary_data(spec, case, patch, mesh.face_centres[mesh.patch_slice(patch)],
+                            values)
 
 
 def _edit_thermo_fields(spec: CaseSpec, case: Path, geom: CaseGeometry) -> None:

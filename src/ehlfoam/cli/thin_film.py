@@ -131,6 +131,10 @@ def cmd_thin_film(args: argparse.Namespace) -> int:
     spec = (load_case_spec(args.spec, **overrides) if args.spec
             else make_case_spec(None, **overrides))
     check_output(args.out, "--out")        # before anything is solved
+    if spec.stop.at is not None:           # a start state is the balance at speed
+        print(f"note: stop.at = {spec.stop.at:g} s is not applied: ehlfoam thin-film marches "
+              "at contact.speed to a start state (a case's run applies the stop: ehlfoam "
+              "case, ehlfoam run)", file=sys.stderr)
     start = None
     if args.start is not None:
         try:

@@ -214,6 +214,9 @@ def _report_case(case_dir: str | os.PathLike, animate: bool, gif_frames: int) ->
     settle = steps.run("history chart", _history, info, out, page)
     if animate and fields is not None and not thin:
         steps.run("transient GIF", _gif, info, fields, out, page, gif_frames)
+    if animate and thin and info.geom is not None and info.spec is not None \
+            and info.spec.stop.at is not None:
+        steps.run("stop GIF", _stop, info, out, page)
     if summary_top:
         page.summary.extend(summary_top)
     if info.metrics and fields is not None:
@@ -366,6 +369,34 @@ def _gif(info: CaseInfo, fields, out: Path, page: Page, max_frames: int) -> None
         page.figures.append(Figure("transient.gif", "The transient (top view at each write)",
                                    "Mid-gap oil fraction at the written times; black: the "
                                    "alpha = 0.5 meniscus."))
+
+
+def _stop(info: CaseInfo, out: Path, page: Page) -> None:
+    from ehlfoam.report.stop import make_stop_pictures
+
+    stop = info.spec.stop
+    gif, png, recs = make_stop_pictures(info.path, info.geom, stop, info.spec.speed, out)
+    if gif is None:
+        page.summary.append("No frames of the stop yet (DIR/frames/): no stop GIF.")
+        return
+    page.figures.append(Figure(
+        "stop.gif", "The sudden stop (a frame every "
+        f"{stop.frame_interval * 1e3:g} ms)",
+        f"The walls slow from {info.spec.speed * 1e3:g} mm/s to rest over "
+        f"{stop.duration * 1e3:g} ms from t = {stop.at * 1e3:g} ms; the model's oil as a "
+        "mid-gap oil fraction (amber: flooded; pale: air, the bubble's gas inside the "
+        "region), the time from the stop, the walls' speed and the metrics' reading on each."))
+    page.figures.append(Figure("stop_frames.png", "The stop: six frames",
+                               "Before the stop, during it and 0-0.1 s after rest."))
+    last = recs[-1]
+    enclosed = [r for r in recs if r["cavities"] > 0 and r["from_stop_s"] >= 0]
+    page.summary.append(
+        f"The stop: {len(recs)} frames; at the end ({last['from_stop_s'] * 1e3:.0f} ms from "
+        f"the stop) the region is {last['flooded_length_over_a'] or 0:.2f} a long and "
+        f"{last['flooded_width_over_a'] or 0:.2f} a wide with {last['cavities']} enclosed "
+        f"gas pocket(s); the last frame with gas enclosed: "
+        + (f"{enclosed[-1]['from_stop_s'] * 1e3:.0f} ms from the stop." if enclosed
+           else "none after the stop began."))
 
 
 def read_report_json(case: Path) -> dict | None:

@@ -199,7 +199,8 @@ def run_case(case: str | Path, runtime: FoamRuntime | None = None,
             _extend_end_time(path, run.geom, extend_transits)
         monitor = _Monitor(run, runtime=runtime or FoamRuntime.from_environment(),
                            wall_limit=wall_limit or run.spec.run.wall_limit,
-                           on_sample=on_sample, check_steady=extend_transits is None,
+                           on_sample=on_sample,
+                           check_steady=extend_transits is None and run.spec.stop.at is None,
                            lock=lock, on_note=on_note)
         return monitor.run()
 

@@ -44,17 +44,20 @@ from ehlfoam.run.history import write_history
 from ehlfoam.run.thin_film_record import (Accounts, earlier_samples, sample, thin_film_record,
                                           thin_film_steady)
 from ehlfoam.spec.case import CaseSpec
+from ehlfoam.spec.stop import wall_speed_at
 from ehlfoam.thinfilm.from_spec import problem_from_spec, scene_options
 from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state, save_state
 
-__all__ = ["STATE_FILE", "open_march", "run_thin_film_case", "sigterm_interrupts", "start_of"]
+__all__ = ["FRAMES_DIR", "STATE_FILE", "open_march", "run_thin_film_case", "sigterm_interrupts", "start_of"]
 
 #: the state a thin-film run ends with, in the case folder
 STATE_FILE = "state.npz"
 #: the gas balance's budget a run with thin_film.bubble_gas = "balance" ends with
 GAS_FILE = "gas.json"
+#: the folder of a stopping run's frames (``stop.frame_interval``), a state each
+FRAMES_DIR = "frames"
 #: lines of the log a failed run's record keeps
 LOG_TAIL_LINES = 20
 #: end_reason of an earlier run whose process was killed (run.monitor's MONITOR_KILLED)
@@ -116,9 +119,37 @@ def open_march(path: Path, spec: CaseSpec, geom: CaseGeometry
     start, t0, history, initial = start_of(path)
     write_metrics(path, MetricsRecord(status="running", cells=geom.cells))
     prob = problem_from_spec(spec, GapField.load(path / "precalc"), scene_options(spec))
+    stop = spec.stop
     m = Marcher(prob, start=start, courant=spec.thin_film.courant,
-                transit_length=spec.run.transit_length * spec.a)
+                transit_length=spec.run.transit_length * spec.a,
+                speed_at=None if stop.at is None else
+                (lambda t: wall_speed_at(stop, spec.speed, t0 + t)))
     return m, t0, history, initial
+
+
+class _Frames:
+    """A stopping run's frames: its state every ``stop.frame_interval`` of run time from
+    ``stop.frames_from`` before the stop on, as ``DIR/frames/NNNN.npz``
+    (:func:`~ehlfoam.thinfilm.state.save_state`; the report's GIF). None of them without a
+    stop."""
+
+    def __init__(self, path: Path, spec: CaseSpec, t0: float):
+        stop = spec.stop
+        self.folder, self.t0 = path / FRAMES_DIR, t0
+        self.on = stop.at is not None
+        if not self.on:
+            return
+        self.every = stop.frame_interval
+        first = max(0.0, stop.at - stop.frames_from)
+        self.k = max(0, math.ceil((t0 - first) / self.every - 1e-9))
+        self.first = first
+        self.folder.mkdir(exist_ok=True)
+
+    def after_step(self, m: Marcher) -> None:
+        """Write a frame when the march reached the next frame's time."""
+        if self.on and self.t0 + m.time >= self.first + self.k * self.every - 1e-12:
+            save_state(m.solution(), self.folder / f"{self.k:04d}.npz")
+            self.k += 1
 
 
 def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
@@ -129,6 +160,9 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
     write_every = max(1, round(m.steps_per_transit / spec.run.writes_per_transit))
     window = spec.thin_film.steady_window * geom.transit_time
     log = _Log(path / geom.log_name, spec, geom, m, t0)
+    frames = _Frames(path, spec, t0)
+    frames.after_step(m)      # the start, when it is a frame's time
+    stopping = spec.stop.at is not None   # runs to its end: no steady-state test
     first = before = Accounts.of(m, t0)
     oil_start = m.oil()
     reason, kind, failure = None, None, None
@@ -144,12 +178,13 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
             except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
                 failure = err
                 break
+            frames.after_step(m)
             if m.steps % write_every == 0 or m.steps == n_steps:
                 s, before = sample(m, t0, geom, before)
                 history.append(s)
                 if on_sample:
                     on_sample(s, geom)
-                kind = None if extend else thin_film_steady(
+                kind = None if extend or stopping else thin_film_steady(
                     history, window, spec.run.steady_tolerance, spec.run.transit_length)
                 if kind and not m.gas_settled(spec.run.steady_tolerance,
                                               spec.thin_film.steady_window):
@@ -263,7 +298,7 @@ class _Log:
                     f"{fmt(p.get('flooded_width_over_a'))} a, bubble "
                     f"{fmt(p.get('bubble_length_over_a'))} a, {rec['cavity_cells']} cavity "
                     f"cells, {rec['cells_opened_to_gas']} opened to gas, "
-                    f"{rec['cells_opened_dry']} ran dry"
+                    f"{rec['cells_opened_dry']} ran dry, walls at {m.speed * 1e3:.4g} mm/s"
                     + (f", gas {rec['gas_pressure_Pa'] / 1e3:.2f} kPa, "
                        f"{2.0 * rec['gas_held_mol']:.3g} mol" if "gas_held_mol" in rec else ""))
 

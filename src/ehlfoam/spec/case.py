@@ -39,6 +39,7 @@ from ehlfoam.spec.ladder import RUNGS, THIN_FILM_START, expand_rung
 from ehlfoam.spec.levels import FOLLOW_POLAR_RADIUS, POLAR_RING_SHARE
 from ehlfoam.spec.mesh import Mesh
 from ehlfoam.spec.sections import STRICT, Domain, Physics, Run, Supply
+from ehlfoam.spec.stop import Stop, check_stop, stop_end_time
 from ehlfoam.spec.thin_film import (THIN_FILM_WRITES_PER_TRANSIT, THREE_D_ONLY, ThinFilm,
                                      check_thin_film)
 
@@ -97,6 +98,9 @@ class CaseSpec(BaseModel):
     cycle: Cycle = Field(Cycle(), description='The cycle of passes of supply.mode = "rig": '
                                               'the tracks\' reflow and when the cycle ends '
                                               '(the other supply modes ignore it).')
+    stop: Stop = Field(Stop(), description='The walls\' stop: from contact.speed to rest '
+                                           'over stop.duration from stop.at (every scene; '
+                                           'unset: they roll throughout).')
 
     @model_validator(mode="before")
     @classmethod
@@ -201,8 +205,9 @@ class CaseSpec(BaseModel):
 
     @property
     def end_time(self) -> float:
-        """Simulated time limit [s]."""
-        return self.run.end_time or self.run.transits_max * self.transit_time
+        """Simulated time limit [s]: with a stop, stop.after past rest."""
+        return (stop_end_time(self.stop) or self.run.end_time
+                or self.run.transits_max * self.transit_time)
 
     def to_toml_dict(self) -> dict[str, Any]:
         """The spec as plain TOML-able data (None values dropped)."""
@@ -233,6 +238,7 @@ def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> Case
     _check_supply_fits(spec)
     check_thin_film(spec)
     check_rig(spec)
+    check_stop(spec)
     _check_scene_options(spec)
     if spec.run.start == "thin-film" and spec.scene != "thin-film":
         thin_film_counterpart(spec)   # the start must exist: refused now, not after a build
@@ -272,6 +278,7 @@ def thin_film_counterpart(spec: CaseSpec, level: str = THIN_FILM_START["resoluti
     if spec.mesh.follow is not None or str(spec.rung).startswith("resolved-"):
         data["physics"].pop("contact_angle", None)   # the wall's, at the slip's scale: the
         # model's menisci hold the static angle (docs/ladder.md)
+    data.pop("stop", None)   # the start is the balance at speed, before any stop
     data.update(scene="thin-film", rung=f"thin-film-{level}", mesh={},
                 run={"transits_max": transits_max, "wall_limit": spec.run.wall_limit})
     try:

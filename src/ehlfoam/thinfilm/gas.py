@@ -115,7 +115,8 @@ class CavityGas:
     splits and merges), and the budget of what it exchanged.
 
     ``h``: the gap at the cells (0 in the island) [m]; ``hx``, ``hy``: at the x and y faces
-    [m]; ``cell`` [m]; ``speed`` u [m/s]."""
+    [m]; ``cell`` [m]; ``speed`` u [m/s] (:attr:`u`, which a march with a stop changes
+    between steps: at rest the exchange with oil sliding past stops)."""
 
     def __init__(self, constants: GasBalance, h: np.ndarray, hx: np.ndarray, hy: np.ndarray,
                  cell: float, speed: float):
@@ -204,7 +205,8 @@ class CavityGas:
         first = ndimage.minimum(x_index, labels, idx)
         last = ndimage.maximum(x_index, labels, idx)
         length = (np.asarray(last) - np.asarray(first) + 1.0) * d if cols.size else 0.0
-        t = length / u                                  # the oil's time along the cavity
+        # the oil's time along the cavity; at rest (walls stopped) no oil slides past it
+        t = length / u if u > 0 else np.full(np.shape(length), np.inf)
         # meniscus area: pi h / 2 on every face between a cavity cell and a flooded one
         area = np.zeros(cavity.shape)
         for axis, hf in ((1, self.hx), (0, self.hy)):

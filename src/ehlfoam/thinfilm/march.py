@@ -92,12 +92,23 @@ class Marcher:
     outlet and the side since its start [m3, half domain] (:attr:`oil_in`,
     :attr:`oil_out_outlet`, :attr:`oil_out_side`), step by step, and what left through the
     outlet on each row (:attr:`oil_out_rows`, the profile the contact leaves behind).
-    :meth:`set_supply` changes the supply between steps (a cycle's next pass)."""
+    :meth:`set_supply` changes the supply between steps (a cycle's next pass).
+
+    ``speed_at``: the walls' speed [m/s] at the march's time [s] (a stop,
+    :func:`ehlfoam.spec.stop.wall_speed_at`); each step takes it at the step's middle and
+    scales every flux the walls drive by it (Couette, the supply, the films a receding
+    meniscus lays, the gas's exchange), the step staying the one of ``prob.speed``, the
+    speed the march starts at. None: ``prob.speed`` throughout."""
 
     def __init__(self, prob: ThinFilmProblem, *, start: ThinFilmSolution | None = None,
-                 courant: float = 0.25, transit_length: float | None = None):
+                 courant: float = 0.25, transit_length: float | None = None,
+                 speed_at: Callable[[float], float] | None = None):
         if not 0 < courant <= 1:
             raise ValueError(f"courant = {courant!r} is out of range: must be in (0, 1]")
+        if not prob.speed > 0:
+            raise ValueError(f"speed = {prob.speed!r} m/s is out of range: a march must "
+                             "start with the walls rolling (> 0 m/s); speed_at slows them")
+        self.speed_at = speed_at
         self.prob = prob
         self.grid = grid = Grid.build(prob)
         self.ops = Operators(prob, grid)
@@ -119,7 +130,7 @@ class Marcher:
         self.p = np.full(self.c.shape, np.nan)
         self.steps = 0
         self.history: list[dict] = []
-        self._out = self._dry = self._cavitated = 0.0
+        self._out = self._dry = self._cavitated = self._in = 0.0
         self.gas = None if prob.gas is None else CavityGas(prob.gas, h, grid.hx, grid.hy, d, u)
         if self.gas is not None and start is not None and start.gas is not None \
                 and start.gas.shape == h.shape:     # the air of a state on this grid
@@ -132,8 +143,24 @@ class Marcher:
         the step and the accounts go on."""
         self.prob = replace(self.prob, supply_layers=(np.asarray(layers[0], float),
                                                       np.asarray(layers[1], float)))
-        self.ops = Operators(self.prob, self.grid)
+        self.ops = Operators(replace(self.prob, speed=self.ops.u), self.grid)
         self.q_in = float(self.ops.q_supply.sum())
+
+    @property
+    def speed(self) -> float:
+        """The walls' speed of the last step [m/s] (of the first before any)."""
+        return self.ops.u
+
+    def _follow_speed(self) -> None:
+        """The walls' speed of the coming step (``speed_at`` at its middle): the operators
+        and the gas's exchange rebuilt for it when it changed."""
+        u = max(0.0, float(self.speed_at(self.time + 0.5 * self.dt)))
+        if u == self.ops.u:
+            return
+        self.ops = Operators(replace(self.prob, speed=u), self.grid)
+        self.q_in = float(self.ops.q_supply.sum())
+        if self.gas is not None:
+            self.gas.u = u
 
     @property
     def time(self) -> float:
@@ -147,6 +174,8 @@ class Marcher:
     def step(self) -> None:
         """One step; a transit's record is added to :attr:`history` after each
         ``steps_per_transit`` steps."""
+        if self.speed_at is not None:
+            self._follow_speed()
         gas = self.gas
         c_old, flooded_old = self.c, self.flooded
         s = self.ops.step(self.flooded, self.c, self.dt,
@@ -163,6 +192,7 @@ class Marcher:
         self.p = s.p
         self.steps += 1
         self.oil_in += self.q_in * self.dt
+        self._in += self.q_in * self.dt
         self.oil_out_outlet += s.q_outlet * self.dt
         self.oil_out_rows += s.outlet_rows * self.dt
         self.oil_out_side += s.q_side * self.dt
@@ -182,8 +212,7 @@ class Marcher:
         rec = {"time_s": self.time,
                "oil_m3": float(np.sum(np.where(region, self.h, 0.0))) * d * d,
                "flooded_cells": int(region.sum()),
-               "outflow_over_supply": self._out / (self.q_in * self.steps_per_transit
-                                                   * self.dt) if self.q_in > 0 else 0.0,
+               "outflow_over_supply": self._out / self._in if self._in > 0 else 0.0,
                "width_m": float(2 * (grid.y[rows[-1]] + d / 2)) if rows.size else 0.0,
                "cells_opened_dry": int(self._dry),
                "cells_opened_to_gas": int(self._cavitated),
@@ -192,7 +221,7 @@ class Marcher:
             rec.update(gas_held_mol=self.gas.held(),
                        gas_pressure_Pa=self.gas.last.get("pressure_Pa", float("nan")),
                        **self.gas.budget)
-        self._out = self._dry = self._cavitated = 0.0
+        self._out = self._dry = self._cavitated = self._in = 0.0
         return rec
 
     def cavity(self) -> np.ndarray:

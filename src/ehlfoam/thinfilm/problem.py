@@ -30,7 +30,8 @@ class ThinFilmProblem:
 
     Attributes:
         gap: h(x, y) [m] for arrays x, y [m] (contact centre at the origin, rolling along +x).
-        speed: u of both walls [m/s].
+        speed: u of both walls [m/s] (0: at rest, the problem of a march's step after a
+            stop; a march itself starts at u > 0).
         viscosity: oil viscosity [Pa s].
         surface_tension: [N/m].
         contact_angle: static contact angle of the oil on both walls [deg].
@@ -113,7 +114,7 @@ class ThinFilmProblem:
     def __post_init__(self) -> None:
         span = min(self.y_max / 2, (self.x_range[1] - self.x_range[0]) / 8)
         checks = {
-            "speed": (self.speed, self.speed > 0, "> 0 m/s"),
+            "speed": (self.speed, self.speed >= 0, ">= 0 m/s (0: the walls at rest)"),
             "viscosity": (self.viscosity, self.viscosity > 0, "> 0 Pa s"),
             "surface_tension": (self.surface_tension, self.surface_tension > 0, "> 0 N/m"),
             "contact_angle": (self.contact_angle, 0 <= self.contact_angle < 90,
