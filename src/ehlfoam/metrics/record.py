@@ -230,6 +230,12 @@ class MetricsRecord(BaseModel):
     cycle_period_passes: int | None = _text(
         "The settled cycle's period in passes (1: periodic, every pass alike)",
         "Cycle period (passes)")
+    cycle_state_II_share: float | None = _key(
+        "The share of the cycle's last max(2 K, 8) passes in state II; the cycle's state is "
+        "that of most of them (near the transition the state flips from pass to pass)", "1",
+        "Passes in state II, settled cycle", "%", 100.0)
+    cycle_state_window_passes: int | None = _text(
+        "The last passes the cycle's settled state is read over", "Passes the state is read over")
     cycle_pass_time_s: float | None = _key(
         "A pass of the cycle: a K-th of the disc's revolution", "s", "Cycle pass time")
     cycle_arcs: int | None = _text("K: the disc track's arcs, a pass each (round(r / R))",

@@ -20,11 +20,13 @@ Every pass writes a row of ``DIR/cycle.csv`` (its supply, state, inlet meniscus,
 the oil in the flooded region, the contact's domain and on each track, the rig's oil and
 its balance), the contact's ``state.npz`` and the tracks' ``tracks.npz``: a cycle that is
 stopped goes on from its last pass when run again, nothing lost (a pass cut short is made
-again: its state is not written, so the contact's and the tracks' oil stay in step). ``metrics.json`` holds the
-last pass's flow pattern (the thin-film run's keys) and the cycle's summary (``cycle_*``,
-``oil_rig_*`` keys) and the contact's film at the settled passes' inlet meniscus
-(``hc_over_hc_flooded``, :func:`settled_film`). Volumes are the whole contact's and the whole tracks' (twice the half
-width marched).
+again: its state is not written, so the contact's and the tracks' oil stay in step); one
+that ended makes no more passes when run again (its record is written anew).
+``metrics.json`` holds the settled flow pattern (the state of most of the last passes,
+:func:`settled_pattern`), the cycle's summary (``cycle_*``, ``oil_rig_*`` keys) and the
+contact's film at the settled passes' inlet meniscus (``hc_over_hc_flooded``,
+:func:`settled_film`). Volumes are the whole contact's and the whole tracks' (twice the
+half width marched).
 """
 
 from __future__ import annotations
@@ -56,10 +58,12 @@ from ehlfoam.thinfilm.state import load_state, save_state
 from ehlfoam.tracks.rig import Rig, Tracks, equivalent_band
 
 __all__ = ["CYCLE_FILE", "START_TRACKS", "TRACKS_FILE", "cycle_end", "rig_of", "run_cycle_case",
-           "settled_film", "settled_supply"]
+           "settled_film", "settled_pattern", "settled_supply"]
 
 #: in the case folder: a row a pass, and the tracks' layers after the last pass
 CYCLE_FILE, TRACKS_FILE = "cycle.csv", "tracks.npz"
+#: the fewest passes the settled state is read over (:func:`settled_pattern`)
+WINDOW_MIN = 8
 #: in the case's ehlfoam/: the tracks a cycle started from another's begins with
 START_TRACKS = "start_tracks.npz"
 
@@ -123,8 +127,11 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
     t_wall = time.monotonic()
     previous = signal.getsignal(signal.SIGTERM)
     handled = sigterm_interrupts()
+    if rows:   # an ended cycle run again: no more passes
+        reason, period = cycle_end(rows, rig.arcs, spec.cycle.tolerance,
+                                   spec.cycle.period_max)
     try:
-        while tracks.passes < spec.cycle.passes_max:
+        while reason is None and tracks.passes < spec.cycle.passes_max:
             t_pass = time.monotonic()
             inlet = tracks.inlet(rig)
             m.set_supply(inlet)
@@ -181,6 +188,7 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
     last = rows[-1] if rows else {}
     disc, ball = tracks.oil(rig)
     rig_now = 2.0 * (disc + ball + m.oil())
+    record = record.updated(**settled_pattern(history[-len(rows):] if rows else [], rig.arcs))
     record = record.updated(
         steady=reason == "periodic", cycle_end_reason=reason, cycle_passes=len(rows),
         cycle_period_passes=period, cycle_pass_time_s=rig.pass_time,
@@ -195,6 +203,23 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
             f"{type(failure).__name__}: {failure}".split())[:500])
     write_metrics(path, record)
     return record
+
+
+def settled_pattern(passes: list[Sample], arcs: int) -> dict:
+    """The flow pattern a cycle settled in, from its passes' samples (a pass each): the state
+    of most of the last max(2 K, 8) passes (the last pass's on a tie) and the pattern of the
+    last pass in that state; ``cycle_state_II_share``, the share of those passes in state
+    II. Near the transition the state flips from pass to pass (the region's rear pinches
+    within a cell); the last pass's state alone would be a draw."""
+    window = [s for s in passes[-max(2 * arcs, WINDOW_MIN):] if s.pattern.get("state")]
+    if not window:
+        return {}
+    states = [s.pattern["state"] for s in window]
+    share = states.count("II") / len(states)
+    state = "II" if share > 0.5 else "I" if share < 0.5 else states[-1]
+    pick = next(s for s in reversed(window) if s.pattern["state"] == state)
+    return {**pick.pattern, "cycle_state_II_share": share,
+            "cycle_state_window_passes": len(window)}
 
 
 def settled_film(spec: CaseSpec, rows: list[dict], arcs: int) -> dict:
