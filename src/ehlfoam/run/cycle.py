@@ -125,53 +125,49 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
     oil_start = m.oil()
     reason, failure, period = None, None, None
     t_wall = time.monotonic()
-    previous = signal.getsignal(signal.SIGTERM)
-    handled = sigterm_interrupts()
     if rows:   # an ended cycle run again: no more passes
         reason, period = cycle_end(rows, rig.arcs, spec.cycle.tolerance,
                                    spec.cycle.period_max)
     try:
-        while reason is None and tracks.passes < spec.cycle.passes_max:
-            t_pass = time.monotonic()
-            inlet = tracks.inlet(rig)
-            m.set_supply(inlet)
-            m.oil_out_rows[:] = 0.0
-            took, side0 = m.oil_in, m.oil_out_side
-            try:
-                for _ in range(rig.pass_steps):
-                    m.step()
-                if not np.isfinite(m.c).all():
-                    raise FloatingPointError("the oil content is no longer finite")
-            except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
-                failure = err
-                break
-            with _signals_held():   # a pass is booked whole: its tracks, row and files
-                took, side = m.oil_in - took, m.oil_out_side - side0
-                s, before = sample(m, t0, geom, before)
-                history.append(s)
-                arc = tracks.next_arc
-                tracks.lay(rig, m.oil_out_rows, side)
-                row = _row(tracks, rig, m, s, arc, took, float(m.oil_out_rows.sum()) + side,
-                           rig_initial, time.monotonic() - t_pass, inlet)
-                rows.append(row)
-                _save(path, rows, tracks, m)
-                write_history(path, history)
-            if on_sample:
-                on_sample(s, geom)
-            if on_pass:
-                on_pass(row)
-            reason, period = cycle_end(rows, rig.arcs, spec.cycle.tolerance,
-                                       spec.cycle.period_max)
-            if reason:
-                break
-            if time.monotonic() - t_wall > wall_limit:
-                reason = "wall_limit"
-                break
+        with sigterm_interrupts():
+            while reason is None and tracks.passes < spec.cycle.passes_max:
+                t_pass = time.monotonic()
+                inlet = tracks.inlet(rig)
+                m.set_supply(inlet)
+                m.oil_out_rows[:] = 0.0
+                took, side0 = m.oil_in, m.oil_out_side
+                try:
+                    for _ in range(rig.pass_steps):
+                        m.step()
+                    if not np.isfinite(m.c).all():
+                        raise FloatingPointError("the oil content is no longer finite")
+                except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
+                    failure = err
+                    break
+                with _signals_held():   # a pass is booked whole: its tracks, row and files
+                    took, side = m.oil_in - took, m.oil_out_side - side0
+                    s, before = sample(m, t0, geom, before)
+                    history.append(s)
+                    arc = tracks.next_arc
+                    tracks.lay(rig, m.oil_out_rows, side)
+                    row = _row(tracks, rig, m, s, arc, took, float(m.oil_out_rows.sum()) + side,
+                               rig_initial, time.monotonic() - t_pass, inlet)
+                    rows.append(row)
+                    _save(path, rows, tracks, m)
+                    write_history(path, history)
+                if on_sample:
+                    on_sample(s, geom)
+                if on_pass:
+                    on_pass(row)
+                reason, period = cycle_end(rows, rig.arcs, spec.cycle.tolerance,
+                                           spec.cycle.period_max)
+                if reason:
+                    break
+                if time.monotonic() - t_wall > wall_limit:
+                    reason = "wall_limit"
+                    break
     except KeyboardInterrupt:   # the last pass's state and tracks stay: it goes on from them
         reason = "interrupted"
-    finally:
-        if handled:
-            signal.signal(signal.SIGTERM, previous)
     wall = time.monotonic() - t_wall
     if failure is not None:
         reason = "diverged"

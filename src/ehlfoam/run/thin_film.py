@@ -27,7 +27,8 @@ import math
 import signal
 import time
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -50,7 +51,8 @@ from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state, save_state
 
-__all__ = ["FRAMES_DIR", "STATE_FILE", "open_march", "run_thin_film_case", "sigterm_interrupts", "start_of"]
+__all__ = ["FRAMES_DIR", "STATE_FILE", "open_march", "run_thin_film_case", "sigterm_interrupts",
+           "start_of"]
 
 #: the state a thin-film run ends with, in the case folder
 STATE_FILE = "state.npz"
@@ -167,42 +169,38 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
     oil_start = m.oil()
     reason, kind, failure = None, None, None
     t_wall = time.monotonic()
-    previous = signal.getsignal(signal.SIGTERM)
-    handled = sigterm_interrupts()
     try:
-        while m.steps < n_steps:
-            try:
-                m.step()
-                if not np.isfinite(m.c).all():
-                    raise FloatingPointError("the oil content is no longer finite")
-            except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
-                failure = err
-                break
-            frames.after_step(m)
-            if m.steps % write_every == 0 or m.steps == n_steps:
-                s, before = sample(m, t0, geom, before)
-                history.append(s)
-                if on_sample:
-                    on_sample(s, geom)
-                kind = None if extend or stopping else thin_film_steady(
-                    history, window, spec.run.steady_tolerance, spec.run.transit_length)
-                if kind and not m.gas_settled(spec.run.steady_tolerance,
-                                              spec.thin_film.steady_window):
-                    kind = None       # the bubble's gas still filling or emptying
-            if m.steps % m.steps_per_transit == 0:
-                log.transit(m, t0, history[-1] if history else None)
-                write_history(path, history)
-            if kind:
-                reason = "steady"
-                break
-            if time.monotonic() - t_wall > wall_limit:
-                reason = "wall_limit"
-                break
+        with sigterm_interrupts():
+            while m.steps < n_steps:
+                try:
+                    m.step()
+                    if not np.isfinite(m.c).all():
+                        raise FloatingPointError("the oil content is no longer finite")
+                except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
+                    failure = err
+                    break
+                frames.after_step(m)
+                if m.steps % write_every == 0 or m.steps == n_steps:
+                    s, before = sample(m, t0, geom, before)
+                    history.append(s)
+                    if on_sample:
+                        on_sample(s, geom)
+                    kind = None if extend or stopping else thin_film_steady(
+                        history, window, spec.run.steady_tolerance, spec.run.transit_length)
+                    if kind and not m.gas_settled(spec.run.steady_tolerance,
+                                                  spec.thin_film.steady_window):
+                        kind = None       # the bubble's gas still filling or emptying
+                if m.steps % m.steps_per_transit == 0:
+                    log.transit(m, t0, history[-1] if history else None)
+                    write_history(path, history)
+                if kind:
+                    reason = "steady"
+                    break
+                if time.monotonic() - t_wall > wall_limit:
+                    reason = "wall_limit"
+                    break
     except KeyboardInterrupt:
         reason = "interrupted"
-    finally:
-        if handled:
-            signal.signal(signal.SIGTERM, previous)
     wall = time.monotonic() - t_wall
     if failure is not None:
         reason, tail = "diverged", log.failure(failure)
@@ -253,16 +251,22 @@ def _write_gas(path: Path, m: Marcher) -> None:
                         **{k: [2.0 * r[k] for r in m.history] for k in g.budget}}})
 
 
-def sigterm_interrupts() -> bool:
-    """SIGTERM raises KeyboardInterrupt (the run ends ``interrupted``, its state written);
-    False where signals cannot be set (not the main thread)."""
+@contextmanager
+def sigterm_interrupts() -> Iterator[None]:
+    """Within the block SIGTERM raises KeyboardInterrupt (the run ends ``interrupted``, its
+    state written); the handler before is put back after it. Nothing changes where signals
+    cannot be set (not the main thread)."""
     def interrupt(signum: int, frame: object) -> None:
         raise KeyboardInterrupt
     try:
-        signal.signal(signal.SIGTERM, interrupt)
+        previous = signal.signal(signal.SIGTERM, interrupt)
     except ValueError:
-        return False
-    return True
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 class _Log:
