@@ -38,7 +38,8 @@ from ehlfoam.spec.cycle import Cycle, check_rig
 from ehlfoam.spec.ladder import RUNGS, THIN_FILM_START, expand_rung
 from ehlfoam.spec.levels import FOLLOW_POLAR_RADIUS, POLAR_RING_SHARE
 from ehlfoam.spec.mesh import Mesh
-from ehlfoam.spec.sections import STRICT, Domain, Physics, Run, Supply
+from ehlfoam.spec.sections import (DEFAULT_CONTACT, STRICT, Domain, Physics, Run, Supply,
+                                   deep_copy, merge_tables)
 from ehlfoam.spec.stop import Stop, check_stop, stop_end_time
 from ehlfoam.spec.thin_film import (THIN_FILM_WRITES_PER_TRANSIT, THREE_D_ONLY, ThinFilm,
                                      check_thin_film)
@@ -82,7 +83,7 @@ class CaseSpec(BaseModel):
                     'would fall below it (the [thin_film] table; seconds to minutes a case; '
                     'keys only the 3D scenes read are refused).')
     contact: PrecalcSpec = Field(
-        PrecalcSpec(speed=0.008),
+        DEFAULT_CONTACT,
         description="The EHL conditions (load, speed, oil, ball): the precalc's spec.")
     supply: Supply = Field(Supply(), description="Oil reaching the contact.")
     physics: Physics = Field(Physics(), description="Fluid properties, wetting and the "
@@ -226,7 +227,7 @@ def make_case_spec(data: dict[str, Any] | None = None, **overrides: Any) -> Case
     data's table (``{"mesh": {"n_layers": 4}}`` keeps its other mesh keys); None clears an
     optional key (``{"mesh.polar_radius": None}``: free quads). Types are strict: no bool
     or string for a number. Raises :class:`SpecError`."""
-    data = _deep_copy(data or {})
+    data = deep_copy(data or {})
     for dotted, value in overrides.items():
         _set_dotted(data, dotted, value)
     try:
@@ -304,22 +305,6 @@ def _check_supply_fits(spec: CaseSpec) -> None:
         raise SpecError("invalid case spec: contact gives a non-finite Hertz radius")
 
 
-def _deep_copy(data):
-    if isinstance(data, dict):
-        return {k: _deep_copy(v) for k, v in data.items()}
-    return data
-
-
-def _merge(into: dict[str, Any], table: dict[str, Any]) -> None:
-    """Merge ``table`` into ``into`` key by key (tables within tables too; other values
-    replace)."""
-    for key, value in table.items():
-        if isinstance(value, dict) and isinstance(into.get(key), dict):
-            _merge(into[key], value)
-        else:
-            into[key] = _deep_copy(value)
-
-
 def _set_dotted(data: dict[str, Any], dotted: str, value: Any) -> None:
     """Set the override ``dotted`` = ``value`` in ``data``: each key before the last must be
     a table of the case spec (:class:`SpecError` naming the key otherwise: ``contact.speed.x``
@@ -350,7 +335,7 @@ def _set_dotted(data: dict[str, Any], dotted: str, value: Any) -> None:
             raise SpecError(f"invalid case spec: {dotted}: {name} = {child!r} is not a table")
         node = child
     if isinstance(value, dict) and isinstance(node.get(leaf), dict):
-        _merge(node[leaf], value)
+        merge_tables(node[leaf], value)
     else:
         node[leaf] = value
 

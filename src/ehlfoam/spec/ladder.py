@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ehlfoam.spec.sections import DEFAULT_CONTACT, deep_copy, merge_tables
 
 __all__ = ["LEVELS", "RESOLVED_FAMILY", "RESOLVED_SLIP_RATIO", "RUNGS", "THIN_FILM_START",
            "cox_voinov", "expand_rung", "rung_family", "rung_level", "rung_of"]
@@ -131,7 +132,7 @@ def _resolved_family(data: dict[str, Any]) -> dict[str, Any]:
         from ehlfoam.spec.sections import Physics, Supply
 
         contact = _table(data, "contact")
-        pc = PrecalcSpec(**contact) if contact else PrecalcSpec(speed=0.008)
+        pc = PrecalcSpec(**contact) if contact else DEFAULT_CONTACT
         supply = Supply(**_table(data, "supply"))
         physics = _table(data, "physics")
         factor = physics.get("viscosity_factor", Physics.model_fields["viscosity_factor"].default)
@@ -156,13 +157,7 @@ def _table(data: dict[str, Any], name: str) -> dict[str, Any]:
 
 def _under(defaults: dict[str, Any], data: dict[str, Any]) -> dict[str, Any]:
     """``data`` with ``defaults`` filled in where it has no key (tables key by key)."""
-    out = dict(data)
-    for key, value in defaults.items():
-        have = out.get(key)
-        if hasattr(have, "model_dump"):
-            have = have.model_dump()
-        if key not in out:
-            out[key] = value
-        elif isinstance(value, dict) and isinstance(have, dict):
-            out[key] = _under(value, have)
+    out = deep_copy(defaults)
+    merge_tables(out, {k: v.model_dump() if hasattr(v, "model_dump") else v
+                       for k, v in data.items()})
     return out

@@ -16,11 +16,35 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from ehlfoam.contact.spec import PrecalcSpec
+
 #: Every table of a spec: unknown keys are refused, values frozen, NaN and inf refused, and
 #: types strict (pydantic's strict mode): no true for a number, no "25" for a number, no 2.0
 #: for an integer; an integer is a number (TOML writes 20 for 20.0). A list is a tuple only
 #: through :func:`as_tuples` (TOML has no tuples).
 STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+
+
+#: The contact of a case spec without a [contact] table: the precalc's defaults at the
+#: reference experiment's 8 mm/s
+DEFAULT_CONTACT = PrecalcSpec(speed=0.008)
+
+
+def deep_copy(data: Any) -> Any:
+    """A copy of a spec's data whose tables (dicts, nested too) are new; values shared."""
+    if isinstance(data, dict):
+        return {k: deep_copy(v) for k, v in data.items()}
+    return data
+
+
+def merge_tables(into: dict[str, Any], table: dict[str, Any]) -> None:
+    """Merge ``table`` into ``into`` key by key (tables within tables too; other values
+    replace)."""
+    for key, value in table.items():
+        if isinstance(value, dict) and isinstance(into.get(key), dict):
+            merge_tables(into[key], value)
+        else:
+            into[key] = deep_copy(value)
 
 
 def as_tuples(value: Any) -> Any:
