@@ -49,7 +49,8 @@ from ehlfoam.gap.starved import starved_film
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run.fields import Sample
 from ehlfoam.run.history import write_history
-from ehlfoam.run.thin_film import STATE_FILE, open_march, sigterm_interrupts
+from ehlfoam.run.thin_film import (MARCH_ERRORS, STATE_FILE, advance, open_march,
+                                   sigterm_interrupts)
 from ehlfoam.run.thin_film_record import Accounts, sample, thin_film_record
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.cycle import rig_layers
@@ -137,11 +138,8 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
                 m.oil_out_rows[:] = 0.0
                 took, side0 = m.oil_in, m.oil_out_side
                 try:
-                    for _ in range(rig.pass_steps):
-                        m.step()
-                    if not np.isfinite(m.c).all():
-                        raise FloatingPointError("the oil content is no longer finite")
-                except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
+                    advance(m, rig.pass_steps)
+                except MARCH_ERRORS as err:
                     failure = err
                     break
                 with _signals_held():   # a pass is booked whole: its tracks, row and files

@@ -51,8 +51,8 @@ from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state, save_state
 
-__all__ = ["FRAMES_DIR", "STATE_FILE", "open_march", "run_thin_film_case", "sigterm_interrupts",
-           "start_of"]
+__all__ = ["FRAMES_DIR", "MARCH_ERRORS", "STATE_FILE", "advance", "open_march",
+           "run_thin_film_case", "sigterm_interrupts", "start_of"]
 
 #: the state a thin-film run ends with, in the case folder
 STATE_FILE = "state.npz"
@@ -173,10 +173,8 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
         with sigterm_interrupts():
             while m.steps < n_steps:
                 try:
-                    m.step()
-                    if not np.isfinite(m.c).all():
-                        raise FloatingPointError("the oil content is no longer finite")
-                except (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError) as err:
+                    advance(m)
+                except MARCH_ERRORS as err:
                     failure = err
                     break
                 frames.after_step(m)
@@ -249,6 +247,19 @@ def _write_gas(path: Path, m: Marcher) -> None:
         "per_transit": {"time_s": [r[0] for r in rows], "pressure_Pa": [r[1] for r in rows],
                         "held_mol": [r[2] for r in rows],
                         **{k: [2.0 * r[k] for r in m.history] for k in g.budget}}})
+
+
+#: what a failing march raises (the run ends ``diverged``)
+MARCH_ERRORS = (ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError)
+
+
+def advance(m: Marcher, steps: int = 1) -> None:
+    """``steps`` steps of the march ``m``; FloatingPointError if its oil content is then no
+    longer finite (with :data:`MARCH_ERRORS`, what a failing march raises)."""
+    for _ in range(steps):
+        m.step()
+    if not np.isfinite(m.c).all():
+        raise FloatingPointError("the oil content is no longer finite")
 
 
 @contextmanager
