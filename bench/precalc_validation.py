@@ -15,7 +15,9 @@
 4. The two-phase cavitation option at 20 mm/s, 25 C, 20 N on 257 points along y (513 x
    257): the sub-ambient length and the more-than-half-gas length over a, beside the thesis
    model's 0.9 a; with ``--twophase``, on three grids up to its default (2049 x 1025),
-   each with its time and peak memory.
+   each with its wall and CPU time, the part of it in the sub-ambient solve, the Newton
+   iterations on each grid of its nested iteration (coarsest first), peak memory and the
+   machine's load average.
 5. With ``--stability``: converged / stagnated / failed over M = 10..3e4 x L = 0..20 on
    ``--stability-grid`` points a side (``default``: the solver's own grid).
 6. With ``--accuracy``: the 18-point table (5 / 20 / 30 N x 25 / 40 / 60 C, each at 10 mm/s
@@ -119,19 +121,26 @@ def twophase(grids: tuple[int, ...], workers: int | None) -> list[dict]:
     for n in grids:
         s = solve_in_subprocess(dict(load=20.0, speed=0.02, temperature=25.0,
                                      cavitation="twophase", grid=n), workers=workers)
+        levels = s.get("subambient_levels") or []
         rows.append(dict(grid=s.get("grid", n), converged=bool(s["converged"]),
                          cavity_over_a=s.get("cavity_length_over_a"),
                          half_gas_over_a=s.get("cavity_half_density_length_over_a"),
                          reaches_outlet=s.get("cavity_reaches_outlet"),
                          p_min_Pa=s.get("p_min_Pa"), wall_s=s["wall_s"], cpu_s=s["cpu_s"],
-                         peak_GiB=s["peak_rss_GiB"], failure=s.get("failure")))
+                         subambient_s=sum(lv["wall_s"] for lv in levels) if levels else None,
+                         newton="/".join(str(lv["newton_iterations"]) for lv in levels),
+                         factorisations=sum(lv["factorisations"] for lv in levels),
+                         levels=levels, peak_GiB=s["peak_rss_GiB"],
+                         load=s.get("load_average", [None])[0], failure=s.get("failure")))
     return rows
 
 
 TWOPHASE_COLUMNS = [("grid", "grid", "d"), ("cavity_over_a", "sub-ambient l/a", ".3f"),
                     ("reaches_outlet", "to outlet", ""), ("half_gas_over_a", "half-gas l/a", ".3f"),
                     ("converged", "converged", ""), ("wall_s", "wall [s]", ".0f"),
-                    ("cpu_s", "CPU [s]", ".0f"), ("peak_GiB", "peak [GiB]", ".2f")]
+                    ("cpu_s", "CPU [s]", ".0f"), ("subambient_s", "sub-ambient [s]", ".0f"),
+                    ("newton", "Newton per grid", ""), ("factorisations", "LUs", "d"),
+                    ("peak_GiB", "peak [GiB]", ".2f"), ("load", "load", ".1f")]
 
 
 def stability(M: float, L: float, grid: int | None, workers: int | None = None) -> dict:
