@@ -59,3 +59,14 @@ def test_hierarchy_injects_down_to_the_coarsest_rows():
     assert np.array_equal(grids[0][0], P0[::4, ::4]) and np.array_equal(grids[0][1], 2 * P0[::4, ::4])
     # an odd number of intervals stops the coarsening
     assert len(_hierarchy(P0[:, :512], P0[:, :512], 0.01, coarsest_rows=65)) == 1
+
+
+def test_a_singular_newton_system_is_reported_not_raised():
+    """An unconverged contact (two cycles) can leave the sub-ambient Jacobian singular: the
+    solve then says so in its failure instead of raising (a batch's warm-up solve did)."""
+    r = solve(make_spec(load=20, speed=0.02, temperature=25, grid=65, cavitation="twophase",
+                        max_cycles=2))
+    s = r.summary()
+    assert not r.converged and not r.subambient.converged
+    assert "sub-ambient Newton not converged" in s["failure"]
+    assert s["subambient_levels"][-1]["converged"] is False

@@ -220,11 +220,17 @@ def _newton(P: np.ndarray, P0: np.ndarray, H: np.ndarray, h: float, prob: Proble
         b = r[unknown]
         x = None
         if refined:
-            x, n = _gmres(J, b, _factor(J.tocsc()))
+            try:
+                x, n = _gmres(J, b, _factor(J.tocsc()))
+            except RuntimeError:  # singular: the direct solve below says so
+                x, n = None, 0
             n_lu, n_krylov = n_lu + 1, n_krylov + n
         if x is None:  # a direct solve: scipy's LU with partial pivoting
-            x = spla.splu(J.tocsc()).solve(b)
             n_lu += 1
+            try:
+                x = spla.splu(J.tocsc()).solve(b)
+            except RuntimeError:  # singular (an unconverged contact): stop, not converged
+                break
         step = np.zeros_like(P)
         step[unknown] = x
         # backtracking on the residual norm (the density law has a kink at ambient)
@@ -234,7 +240,7 @@ def _newton(P: np.ndarray, P0: np.ndarray, H: np.ndarray, h: float, prob: Proble
             if t_merit < merit:
                 break
         P, rho, drho, eps, unknown, merit = trial, t_rho, t_drho, t_eps, t_unknown, t_merit
-    return P, res < tol, it, res, n_lu, n_krylov
+    return P, bool(res < tol), it, res, n_lu, n_krylov
 
 
 def _free(P0: np.ndarray, p_fixed: float) -> np.ndarray:
