@@ -15,12 +15,14 @@ flow-continuity start, each finer one from the bilinear interpolation of the coa
 solution, which leaves it a handful of Newton steps. On the refined grids a step moves a
 point at most :data:`INTERIOR_FRACTION` of its way to vacuum (the density, proportional to
 the absolute pressure, never reaches 0 there, and no point is pushed onto the vacuum bound
-only to be released a few at an iteration), and the linear systems are solved by GMRES
-preconditioned by the sparse LU of an earlier Jacobian of the same grid, factored again only
-when GMRES does not converge: one or two factorisations per grid instead of one per step.
-The LU uses a minimum-degree ordering of J + J^T without pivoting (about 60 % of the fill
-of scipy's default column ordering on these grids), falling back to the default if that
-fails.
+only to be released a few at an iteration), and each step's linear system is solved by
+GMRES preconditioned by its own sparse LU in a minimum-degree ordering of J + J^T without
+pivoting (about 60 % of the fill and half the time of scipy's default column ordering with
+partial pivoting on these grids; GMRES makes up for the missing pivoting in one or two
+iterations). An earlier step's LU is no good preconditioner: points crossing ambient
+change their density slope (the law's kink) by orders of magnitude from step to step. The
+coarsest grid uses scipy's default LU, as the plain Newton solve did; every grid is solved
+to ``tol``, so the result is the fine grid's own discrete solution.
 """
 
 from __future__ import annotations
