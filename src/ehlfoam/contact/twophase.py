@@ -12,7 +12,8 @@ Jacobian (scipy), with P >= vacuum as an active-set constraint.
 Nested iteration: the same problem on grids of every other point (film and p >= 0 field
 injected) down to at most :data:`COARSEST_ROWS` rows; the coarsest is solved from the
 flow-continuity start, each finer one from the bilinear interpolation of the coarser
-solution, which leaves it a handful of Newton steps. On the refined grids a step moves a
+solution, which leaves it a handful of Newton steps (a cubic interpolation measured worse:
+16 steps instead of 8 on 1025 x 513). On the refined grids a step moves a
 point at most :data:`INTERIOR_FRACTION` of its way to vacuum (the density, proportional to
 the absolute pressure, never reaches 0 there, and no point is pushed onto the vacuum bound
 only to be released a few at an iteration), and each step's linear system is solved by
