@@ -2,6 +2,7 @@
 
     python bench/precalc_validation.py [--stability [--stability-grid 257|default]]
         [--accuracy] [--twophase] [--workers N] [--out FILE.json]
+    python bench/precalc_validation.py --twophase-only [--quick] [--workers N]
     python bench/precalc_validation.py --quick
 
 1. Dry limit: the solver's elastic kernel with no film (Polonsky-Keer) against Hertz's
@@ -15,7 +16,9 @@
 4. The two-phase cavitation option at 20 mm/s, 25 C, 20 N on 257 points along y (513 x
    257): the sub-ambient length and the more-than-half-gas length over a, beside the thesis
    model's 0.9 a; with ``--twophase``, on three grids up to its default (2049 x 1025),
-   each with its time and peak memory.
+   each with its wall and CPU time, the part of it in the sub-ambient solve, the Newton
+   iterations on each grid of its nested iteration (coarsest first), peak memory and the
+   machine's load average.
 5. With ``--stability``: converged / stagnated / failed over M = 10..3e4 x L = 0..20 on
    ``--stability-grid`` points a side (``default``: the solver's own grid).
 6. With ``--accuracy``: the 18-point table (5 / 20 / 30 N x 25 / 40 / 60 C, each at 10 mm/s
@@ -119,19 +122,26 @@ def twophase(grids: tuple[int, ...], workers: int | None) -> list[dict]:
     for n in grids:
         s = solve_in_subprocess(dict(load=20.0, speed=0.02, temperature=25.0,
                                      cavitation="twophase", grid=n), workers=workers)
+        levels = s.get("subambient_levels") or []
         rows.append(dict(grid=s.get("grid", n), converged=bool(s["converged"]),
                          cavity_over_a=s.get("cavity_length_over_a"),
                          half_gas_over_a=s.get("cavity_half_density_length_over_a"),
                          reaches_outlet=s.get("cavity_reaches_outlet"),
                          p_min_Pa=s.get("p_min_Pa"), wall_s=s["wall_s"], cpu_s=s["cpu_s"],
-                         peak_GiB=s["peak_rss_GiB"], failure=s.get("failure")))
+                         subambient_s=sum(lv["wall_s"] for lv in levels) if levels else None,
+                         newton="/".join(str(lv["newton_iterations"]) for lv in levels),
+                         factorisations=sum(lv["factorisations"] for lv in levels),
+                         levels=levels, peak_GiB=s["peak_rss_GiB"],
+                         load=s.get("load_average", [None])[0], failure=s.get("failure")))
     return rows
 
 
 TWOPHASE_COLUMNS = [("grid", "grid", "d"), ("cavity_over_a", "sub-ambient l/a", ".3f"),
                     ("reaches_outlet", "to outlet", ""), ("half_gas_over_a", "half-gas l/a", ".3f"),
                     ("converged", "converged", ""), ("wall_s", "wall [s]", ".0f"),
-                    ("cpu_s", "CPU [s]", ".0f"), ("peak_GiB", "peak [GiB]", ".2f")]
+                    ("cpu_s", "CPU [s]", ".0f"), ("subambient_s", "sub-ambient [s]", ".0f"),
+                    ("newton", "Newton per grid", ""), ("factorisations", "LUs", "d"),
+                    ("peak_GiB", "peak [GiB]", ".2f"), ("load", "load", ".1f")]
 
 
 def stability(M: float, L: float, grid: int | None, workers: int | None = None) -> dict:
@@ -156,10 +166,19 @@ def main(argv: list[str] | None = None) -> int:
                     help="also the 18-point table against main 5ad327e's hc")
     ap.add_argument("--twophase", action="store_true",
                     help="the two-phase option on three grids up to its default")
+    ap.add_argument("--twophase-only", action="store_true",
+                    help="only that (sections 1-3 and the one-grid section 4 skipped)")
     ap.add_argument("--workers", type=int, default=None, help="threads of each solve")
     add_output_options(ap)
     args = ap.parse_args(argv)
     q = args.quick
+    if args.twophase_only:
+        out = {"twophase_grids": twophase((129, 257, 513) if q else (257, 513, 1025),
+                                          args.workers)}
+        print_table(out["twophase_grids"], TWOPHASE_COLUMNS,
+                    "4. two-phase on three grids, 20 mm/s, 25 C, 20 N (thesis model: 0.9 a)")
+        write_out(args.out, out)
+        return 0
     out: dict = {"dry": [dry(n) for n in ((129,) if q else (257, 513))]}
     print_table(out["dry"], [("grid", "grid", "d"), ("p_max_over_pH", "p_max / p_H", ".6f"),
                              ("max_err_r_lt_095", "max |P - Hertz| r<0.95a", ".2e"),

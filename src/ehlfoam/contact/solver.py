@@ -181,6 +181,12 @@ class PrecalcResult:
                 -0.5 * self.spec.twophase_p_scale)
             if self.subambient is not None:
                 out["subambient_newton_iterations"] = self.subambient.iterations
+                # the nested iteration, coarsest grid first: [nx, ny], Newton iterations,
+                # LU factorisations, wall time [s]
+                out["subambient_levels"] = [
+                    dict(grid=lv["shape"][::-1], newton_iterations=lv["iterations"],
+                         factorisations=lv["factorisations"], converged=lv["converged"],
+                         wall_s=lv["wall_s"]) for lv in self.subambient.levels]
         return out
 
 
