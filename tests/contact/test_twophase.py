@@ -70,3 +70,24 @@ def test_a_singular_newton_system_is_reported_not_raised():
     assert not r.converged and not r.subambient.converged
     assert "sub-ambient Newton not converged" in s["failure"]
     assert s["subambient_levels"][-1]["converged"] is False
+
+
+def test_the_one_way_coupling_leaves_out_a_film_change_it_bounds(direct):
+    """The sub-ambient pressures' elastic deformation, which the held film leaves out: its
+    range over the Hertzian circle from the DC-FFT of their sub-ambient part (the direct
+    sum's on a small grid), none without one, and at 1 m/s a small fraction of the central
+    film (|p| <= ambient, ~1e-4 pH)."""
+    from ehlfoam.contact.elastic import deformation_direct
+    from ehlfoam.contact.twophase import subambient_deformation
+
+    rng = np.random.default_rng(3)
+    P = rng.normal(size=(21, 41))
+    P[0, :] = P[:, 0] = 0.0
+    x, y = np.linspace(-2.0, 2.0, 41), np.linspace(-1.0, 1.0, 21)
+    inside = np.hypot(*np.meshgrid(x, y)) <= 1.0
+    w = deformation_direct(np.minimum(P, 0.0), 0.1, 0.1)
+    assert subambient_deformation(P, 0.1, x, y) == pytest.approx(float(np.ptp(w[inside])),
+                                                                 rel=1e-9)
+    assert subambient_deformation(np.abs(P), 0.1, x, y) == 0.0
+    share = direct.summary()["subambient_deformation_over_hc"]
+    assert 0.0 < share < 0.01

@@ -14,7 +14,7 @@ from ehlfoam.contact.formulas import Contact, moes_to_hertz_film, nijenbanning_m
 from ehlfoam.contact.inlet import meniscus_x_on_centreline
 from ehlfoam.contact.multigrid import Domain, MGResult, MultigridSolver, Problem, SolverOptions
 from ehlfoam.contact.spec import P_AMBIENT_PA, PrecalcSpec
-from ehlfoam.contact.twophase import SubAmbientResult, solve_subambient
+from ehlfoam.contact.twophase import SubAmbientResult, solve_subambient, subambient_deformation
 
 #: When a direct (FMG) start fails, the solve starts again from a solution at a Moes M of
 #: at most this (speed ramp).
@@ -181,6 +181,10 @@ class PrecalcResult:
                 -0.5 * self.spec.twophase_p_scale)
             if self.subambient is not None:
                 out["subambient_newton_iterations"] = self.subambient.iterations
+                # the film change over the contact the one-way coupling leaves out, at most, over hc
+                if self.subambient.deformation_max is not None:
+                    out["subambient_deformation_over_hc"] = (self.subambient.deformation_max
+                                                             / self.H_central)
                 # the nested iteration, coarsest grid first: [nx, ny], Newton iterations,
                 # LU factorisations, wall time [s]
                 out["subambient_levels"] = [
@@ -291,6 +295,8 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
         subambient = solve_subambient(result.P, result.H, dom.h,
                                       replace(prob, p_floor=p_floor, laws=spec.laws()))
         result.P = subambient.P
+        subambient.deformation_max = subambient_deformation(result.P, dom.h, result.x,
+                                                            result.y)
         if not subambient.converged:
             result.converged = False
             result.failure = (f"sub-ambient Newton not converged after {subambient.iterations} "

@@ -35,11 +35,13 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ehlfoam.contact.elastic import Deformation
 from ehlfoam.contact.multigrid import Problem
 from ehlfoam.contact.reynolds import residual
 from ehlfoam.contact.transfer import prolong_bilinear
 
-__all__ = ["COARSEST_ROWS", "INTERIOR_FRACTION", "SubAmbientResult", "solve_subambient"]
+__all__ = ["COARSEST_ROWS", "INTERIOR_FRACTION", "SubAmbientResult", "solve_subambient",
+           "subambient_deformation"]
 
 #: The nested iteration's coarsest grid has at most this many rows (points along y).
 COARSEST_ROWS = 129
@@ -58,7 +60,9 @@ class SubAmbientResult:
     relative to max |wedge term|), the finest grid's Newton iterations and, per grid from the
     coarsest, ``levels``: shape (rows, columns), Newton iterations, LU factorisations, GMRES
     iterations, residual, converged, wall time [s]. ``P_contact``: the p >= 0 field it
-    started from (units pH)."""
+    started from (units pH). ``deformation_max``: how much the sub-ambient pressures'
+    elastic deformation varies over the Hertzian circle (units a^2/R, as the film), which the
+    one-way coupling leaves out (:func:`subambient_deformation`)."""
 
     P: np.ndarray
     converged: bool
@@ -66,6 +70,19 @@ class SubAmbientResult:
     residual: float
     levels: list = field(default_factory=list)
     P_contact: np.ndarray | None = None
+    deformation_max: float | None = None
+
+
+def subambient_deformation(P: np.ndarray, h: float, x: np.ndarray, y: np.ndarray) -> float:
+    """How much the elastic deformation of the sub-ambient part of ``P`` (units pH, on the
+    uniform grid x, y of spacing ``h``, units a) varies over the Hertzian circle (units
+    a^2/R, as the film): what the film there, held while the sub-ambient field is solved,
+    would change by at most if it were coupled back (its uniform part the load balance
+    absorbs)."""
+    ny, nx = P.shape
+    w = Deformation(nx, ny, h, h)(np.minimum(P, 0.0))
+    inside = np.hypot(*np.meshgrid(x, y)) <= 1.0
+    return float(np.ptp(w[inside])) if inside.any() else 0.0
 
 
 def _coefficients(P, H, prob: Problem):
