@@ -29,5 +29,6 @@ def test_the_film_thins_as_the_meniscus_nears_the_contact(cache):
     assert 0.3 < near["hc_over_hc_flooded"] < 0.97 * far["hc_over_hc_flooded"]
     assert starved_film(contact, 0.01) == near                      # held at the range's end
     assert starved_film(contact, 0.52)["starved_meniscus_over_a"] == pytest.approx(0.5)
+    assert starved_film(contact, 1.6)["starved_meniscus_over_a"] == pytest.approx(1.5)
     assert starved_film(contact, None) == {"hc_over_hc_flooded": None,
                                            "starved_meniscus_over_a": None}

@@ -109,9 +109,10 @@ def test_the_cycle_settles_and_records_every_pass(built, tmp_path):
     assert (case / "tracks.npz").is_file() and (case / "state.npz").is_file()
     # the contact's film at the settled passes' inlet meniscus (the starved precalc)
     menisci = [float(r["inlet_meniscus_distance_over_a"]) for r in rows[-2:]]
-    assert m["starved_meniscus_over_a"] == pytest.approx(
-        min(max(sum(menisci) / 2, 0.05), 3.0), abs=0.026)
+    mean = min(max(sum(menisci) / 2, 0.05), 3.0)
+    assert m["starved_meniscus_over_a"] == pytest.approx(mean, abs=0.026 if mean < 1 else 0.126)
     assert 0.3 < m["hc_over_hc_flooded"] <= 1.01
+    assert all(0.3 < float(r["hc_over_hc_flooded"]) <= 1.01 for r in rows)   # every pass's
 
 
 def test_a_stopped_cycle_goes_on_from_its_last_pass(built, tmp_path):

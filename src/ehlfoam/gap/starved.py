@@ -7,7 +7,8 @@ at zero upstream of it, :mod:`ehlfoam.contact.inlet`) gives the film that menisc
 contact build, against the fully flooded film on the same grid (hc / hc,ff). Each meniscus is
 solved once per machine (the precalc cache); the meniscus is rounded to
 :data:`MENISCUS_STEP` for it (an eighth of the thin-film model's coarse cell, which places
-the meniscus no better: the points of a map share their solves), and held within :data:`MENISCUS_RANGE`: nearer than its lower
+the meniscus no better), to :data:`MENISCUS_FAR_STEP` beyond 1 a (so that the passes of a
+cycle and the points of a map share their solves), and held within :data:`MENISCUS_RANGE`: nearer than its lower
 end (at or inside the contact's rim, where a thin-film cell cannot place it better) the film
 is that of the lower end, farther than the upper end the film is the flooded one within
 0.1 % at the reference conditions (Hamrock and Dowson's onset is at m* - 1 ~ 0.2-0.6 a).
@@ -22,13 +23,17 @@ from typing import Any
 from ehlfoam.contact.spec import PrecalcSpec
 from ehlfoam.gap.source import PrecalcFailed, precalc_dir
 
-__all__ = ["MENISCUS_RANGE", "MENISCUS_STEP", "starved_film"]
+__all__ = ["MENISCUS_FAR", "MENISCUS_FAR_STEP", "MENISCUS_RANGE", "MENISCUS_STEP",
+           "starved_film"]
 
 #: The meniscus distances [a] the starved solve is made at: nearer or farther ones are held
 #: at these ends (module docstring).
 MENISCUS_RANGE = (0.05, 3.0)
-#: The starved solves' meniscus distances are rounded to this [a] (one solve each).
-MENISCUS_STEP = 0.05
+#: The starved solves' meniscus distances are rounded to this [a] (one solve each) below
+#: :data:`MENISCUS_FAR`, to :data:`MENISCUS_FAR_STEP` beyond it (where the film hardly
+#: depends on the meniscus: within 0.2 % of the flooded one from 1.5 a to 3 a at the
+#: reference conditions).
+MENISCUS_STEP, MENISCUS_FAR, MENISCUS_FAR_STEP = 0.05, 1.0, 0.25
 
 
 def starved_film(contact: PrecalcSpec, meniscus_over_a: float | None) -> dict[str, Any]:
@@ -41,8 +46,9 @@ def starved_film(contact: PrecalcSpec, meniscus_over_a: float | None) -> dict[st
     if meniscus_over_a is None or not abs(meniscus_over_a) < float("inf"):
         return none
     lo, hi = MENISCUS_RANGE
-    d = round(round(min(max(float(meniscus_over_a), lo), hi) / MENISCUS_STEP)
-              * MENISCUS_STEP, 6)
+    d = min(max(float(meniscus_over_a), lo), hi)
+    step = MENISCUS_STEP if d < MENISCUS_FAR else MENISCUS_FAR_STEP
+    d = round(round(d / step) * step, 6)
     spec = contact.model_copy(update={"inlet_meniscus": d, "inlet_layer": None})
     try:
         folder = precalc_dir(spec)

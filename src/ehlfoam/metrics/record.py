@@ -262,7 +262,7 @@ class MetricsRecord(BaseModel):
         "Central film / flooded film (hc / hc,ff)", "%", 100.0)
     starved_meniscus_over_a: float | None = _key(
         "The inlet meniscus distance from x = -a the starved film was solved at: the mean "
-        "of the cycle's last passes, rounded to 0.05 a and held within 0.05-3 a", "a",
+        "of the cycle's last passes, rounded to 0.05 a (0.25 a beyond 1 a) and held within 0.05-3 a", "a",
         "Inlet meniscus of the starved film")
     # ---------------------------------------------------------------- the run's cost, mesh
     cells: int | None = _text("Cells of the mesh", "Cells")

@@ -16,7 +16,8 @@ pass, its supply the tracks' layers on its rows. The cycle ends:
 - ``passes_max`` (``cycle.passes_max``), ``wall_limit`` (``run.wall_limit``), ``diverged``
   (the march failed), ``interrupted`` (Ctrl-C, SIGTERM).
 
-Every pass writes a row of ``DIR/cycle.csv`` (its supply, state, inlet meniscus, bubble,
+Every pass writes a row of ``DIR/cycle.csv`` (its supply, state, inlet meniscus, the film
+it leaves the contact (``hc_over_hc_flooded``, :func:`ehlfoam.gap.starved.starved_film`), bubble,
 the oil in the flooded region, the contact's domain and on each track, the rig's oil and
 its balance), the contact's ``state.npz`` and the tracks' ``tracks.npz``: a cycle that is
 stopped goes on from its last pass when run again, nothing lost (a pass cut short is made
@@ -45,7 +46,7 @@ from ehlfoam._io import atomic_write_text
 from ehlfoam.case.geometry import META, CaseGeometry, load_geometry, load_spec_of
 from ehlfoam.case.ownership import hold_run_lock
 from ehlfoam.errors import SpecError
-from ehlfoam.gap.starved import starved_film
+from ehlfoam.gap.starved import MENISCUS_RANGE, starved_film
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run.fields import Sample
 from ehlfoam.run.history import write_history
@@ -142,14 +143,16 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
                 except MARCH_ERRORS as err:
                     failure = err
                     break
+                took, side = m.oil_in - took, m.oil_out_side - side0
+                s, before = sample(m, t0, geom, before)
+                film = starved_film(spec.contact, _film_meniscus(s.pattern))
                 with _signals_held():   # a pass is booked whole: its tracks, row and files
-                    took, side = m.oil_in - took, m.oil_out_side - side0
-                    s, before = sample(m, t0, geom, before)
                     history.append(s)
                     arc = tracks.next_arc
                     tracks.lay(rig, m.oil_out_rows, side)
                     row = _row(tracks, rig, m, s, arc, took, float(m.oil_out_rows.sum()) + side,
                                rig_initial, time.monotonic() - t_pass, inlet)
+                    row["hc_over_hc_flooded"] = film["hc_over_hc_flooded"]
                     rows.append(row)
                     _save(path, rows, tracks, m)
                     write_history(path, history)
@@ -219,12 +222,21 @@ def settled_pattern(passes: list[Sample], arcs: int) -> dict:
 def settled_film(spec: CaseSpec, rows: list[dict], arcs: int) -> dict:
     """The contact's film at the inlet meniscus of the cycle's last max(K, 2) passes (their
     mean; :func:`ehlfoam.gap.starved.starved_film` on the contact's grid: hc / hc,ff on 257^2
-    is within 1 % of the default grid's at the reference conditions, docs/models/
+    is within 1.2 % of the default grid's at the reference conditions, docs/models/
     supply-cycle.md)."""
-    last = [float(r["inlet_meniscus_distance_over_a"]) for r in rows[-max(arcs, 2):]
-            if r.get("inlet_meniscus_distance_over_a") not in (None, "")]
-    meniscus = float(np.mean(last)) if last else None
-    return starved_film(spec.contact, meniscus)
+    last = [_film_meniscus(r) for r in rows[-max(arcs, 2):]]
+    last = [float(d) for d in last if d not in (None, "")]
+    return starved_film(spec.contact, float(np.mean(last)) if last else None)
+
+
+def _film_meniscus(pattern: dict) -> float | str | None:
+    """The inlet meniscus distance [a] a pass's starved film is solved at: the pattern's; the
+    far end of the starved solves' range where the oil reaches the domain's inlet edge (a
+    state, no meniscus: the inlet is flooded); None without a state."""
+    d = pattern.get("inlet_meniscus_distance_over_a")
+    if d in (None, "") and pattern.get("state") in ("I", "II"):
+        return MENISCUS_RANGE[1]
+    return d
 
 
 def settled_supply(case: str | Path) -> dict[str, float]:
