@@ -272,14 +272,27 @@ def _start_tracks(path: Path, spec: CaseSpec, rig: Rig) -> Tracks:
 
 @contextmanager
 def _signals_held() -> Iterator[None]:
-    """SIGTERM and SIGINT wait until the block is done (then interrupt as usual), so that an
-    interrupt never leaves a pass half booked: its row counted but its files not written."""
-    held = {signal.SIGTERM, signal.SIGINT}
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    """SIGTERM and SIGINT wait until the block is done (then interrupt: KeyboardInterrupt),
+    so that an interrupt never leaves a pass half booked: its row counted but its files not
+    written. Their Python handlers are swapped for the block, not the signals masked: a mask
+    holds them in this thread only, and the numba and FFT threads can take them (nothing is
+    held where handlers cannot be set: not the main thread)."""
+    caught: list[int] = []
+
+    def hold(signum: int, frame: object) -> None:
+        caught.append(signum)
+    try:
+        old = {sig: signal.signal(sig, hold) for sig in (signal.SIGTERM, signal.SIGINT)}
+    except ValueError:
+        yield
+        return
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+    if caught:
+        raise KeyboardInterrupt
 
 
 def cycle_end(rows: list[dict], arcs: int, tol: float, period_max: int
