@@ -124,7 +124,8 @@ def write_near(case: str | os.PathLike, at: str, transit_time: float) -> tuple[f
     return min(times, key=lambda tf: abs(tf[0] - transits * transit_time))
 
 
-def _uniform_or_list(value, n: int) -> np.ndarray:
+def uniform_or_list(value, n: int) -> np.ndarray:
+    """A field's values as an array: a uniform value repeated ``n`` times, a list as it is."""
     arr = np.asarray(value, dtype=float)
     if arr.ndim == 0:
         return np.full(n, float(arr))
@@ -173,7 +174,7 @@ def _read_alpha(path: Path, structure: Structure) -> tuple[np.ndarray, FoamField
     boundary values)."""
     n = len(structure.cell_volumes)
     file = FoamFieldFile(path)
-    alpha = _uniform_or_list(file.internal_field, n)
+    alpha = uniform_or_list(file.internal_field, n)
     if alpha.shape != (n,):
         raise ValueError(f"{path} has {alpha.shape} values, expected {n}")
     return alpha, file
@@ -258,9 +259,9 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     alpha_bf = alpha_file.boundary_field
 
     def oil_flux(name: str, size: int) -> np.ndarray:
-        flux = _uniform_or_list(flux_bf[name]["value"], size)
+        flux = uniform_or_list(flux_bf[name]["value"], size)
         if not exact:
-            flux = flux * np.clip(_uniform_or_list(alpha_bf[name]["value"], size), 0.0, 1.0)
+            flux = flux * np.clip(uniform_or_list(alpha_bf[name]["value"], size), 0.0, 1.0)
             if name != SUPPLY_PATCH:
                 flux = np.where(flux > 0.0, flux, flux * geom.open_inflow_oil)
         return flux
@@ -272,7 +273,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     pattern["bubble_volume_m3"] = _bubble_volume(r, alpha, structure, geom)
     pattern["oil_smeared_fraction"] = smeared_oil_fraction(alpha, structure.cell_volumes)
     p_file = folder / "p"
-    p = (_uniform_or_list(FoamFieldFile(_complete(p_file)).internal_field, len(alpha))
+    p = (uniform_or_list(FoamFieldFile(_complete(p_file)).internal_field, len(alpha))
          if p_file.exists() else None)
     pattern["min_pressure_Pa"] = _min_pressure(p, geom)
     pattern["gas_release_m3_s"] = gas_release(p, alpha, structure.cell_volumes, geom)
@@ -329,7 +330,7 @@ def volume_flux(folder: Path, structure: Structure, geom: CaseGeometry) -> tuple
     """The total volume flux [m3/s, whole contact] in and out through the open boundaries at
     one written time, from its phi (oil and gas together)."""
     phi = FoamFieldFile(_complete(folder / "phi")).boundary_field
-    q_in, q_out, _ = _in_out(lambda name, size: _uniform_or_list(phi[name]["value"], size),
+    q_in, q_out, _ = _in_out(lambda name, size: uniform_or_list(phi[name]["value"], size),
                              structure, geom)
     return q_in, q_out
 
@@ -340,7 +341,7 @@ def _gas(folder: Path, alpha: np.ndarray, p: np.ndarray, structure: Structure,
     boundaries (whole contact) of a compressible scene: density p/(R T) of the perfect gas
     (``p`` [Pa] per cell), volumetric gas flux phi - alphaPhi0.oil on the boundary faces."""
     temp_file = FoamFieldFile(_complete(folder / "T"))
-    temp = _uniform_or_list(temp_file.internal_field, len(alpha))
+    temp = uniform_or_list(temp_file.internal_field, len(alpha))
     gas = 1.0 - np.clip(alpha, 0.0, 1.0)
     mass = geom.mirror * float(np.sum(gas * p / (AIR_GAS_CONSTANT * temp) * structure.cell_volumes))
     phi = FoamFieldFile(_complete(folder / "phi")).boundary_field
@@ -348,10 +349,10 @@ def _gas(folder: Path, alpha: np.ndarray, p: np.ndarray, structure: Structure,
     p_b, t_b = FoamFieldFile(folder / "p").boundary_field, temp_file.boundary_field
 
     def gas_mass_flux(name: str, size: int) -> np.ndarray:
-        q = (_uniform_or_list(phi[name]["value"], size)
-             - _uniform_or_list(oil[name]["value"], size))          # outward, m3/s per face
-        rho = (_uniform_or_list(p_b[name]["value"], size)
-               / (AIR_GAS_CONSTANT * _uniform_or_list(t_b[name]["value"], size)))
+        q = (uniform_or_list(phi[name]["value"], size)
+             - uniform_or_list(oil[name]["value"], size))          # outward, m3/s per face
+        rho = (uniform_or_list(p_b[name]["value"], size)
+               / (AIR_GAS_CONSTANT * uniform_or_list(t_b[name]["value"], size)))
         return rho * q
 
     m_in, m_out, _ = _in_out(gas_mass_flux, structure, geom)

@@ -1,0 +1,42 @@
+"""What a 3D case leaves behind the contact (ehlfoam.run.outflow, issue 75): the oil through
+its outlet binned into lateral rows is the layer the walls carry away, and summed it is the
+outlet outflow the monitor records. A tiny real OpenFOAM case."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ehlfoam.case.geometry import load_geometry
+from ehlfoam.case.writer import write_case
+from ehlfoam.run.monitor import run_case
+from ehlfoam.run.outflow import outlet_layers
+from ehlfoam.spec.case import make_case_spec
+from tests.tiny import SMALL
+
+
+@pytest.mark.openfoam
+def test_a_3d_case_s_outflow_as_layers_closes_on_its_outlet_outflow(tmp_path):
+    case = tmp_path / "case"
+    write_case(make_case_spec({**SMALL, "name": "outflow",
+                               "run": {**SMALL["run"], "end_time": 2e-3}}), case)
+    m = run_case(case, wall_limit=120)
+    assert m["status"] == "finished", m
+    a, speed = load_geometry(case).a, 0.02
+    row = 0.25 * a
+    layers = outlet_layers(case, row, 40)
+    out = m["oil_outflow_by_boundary_m3_s"]["outlet"]
+    assert out > 0 and (layers >= 0).all()
+    # both sides of the track: twice the half's rows
+    assert 2.0 * speed * row * layers.sum() == pytest.approx(out, rel=1e-9)
+    carrying = np.nonzero(layers > 1e-3 * layers.max())[0]
+    assert carrying[-1] * row < 5.0 * a       # within the domain's side
+    assert outlet_layers(case, 2 * row, 20).sum() * 2 == pytest.approx(layers.sum(), rel=1e-12)
+    # the run wrote them (0.1 a rows, half on each wall)
+    import csv
+    with open(case / "outflow.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    disc = np.array([float(r["disc_layer_m"]) for r in rows])
+    ball = np.array([float(r["ball_layer_m"]) for r in rows])
+    assert disc == pytest.approx(ball, rel=1e-5)
+    assert 2.0 * speed * 0.1 * a * (disc + ball).sum() == pytest.approx(out, rel=1e-5)
