@@ -151,10 +151,11 @@ def _points(rows: list[dict]) -> dict[str, Any]:
 
 
 def _lines(rows: Iterable[dict]) -> list[dict[str, Any]]:
-    """Sweep rows grouped by everything but the speed, with their transitions."""
+    """Sweep rows grouped by everything but the speed, with their transitions (a 3D
+    confirmation is no line of its own: :func:`confirmations` sets it beside its point)."""
     groups: dict[tuple, list[dict]] = defaultdict(list)
     for r in rows:
-        if _is_ramp(r) or _float(r.get(SPEED)) is None:
+        if _is_ramp(r) or r.get("confirms") or _float(r.get(SPEED)) is None:
             continue
         groups[tuple(_group(r).values())].append(r)
     out = []
