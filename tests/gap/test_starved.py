@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from ehlfoam.contact.spec import PrecalcSpec
-from ehlfoam.gap.starved import MENISCUS_RANGE, starved_film
+from ehlfoam.gap.starved import MENISCUS_RANGE, solved_meniscus, starved_film
 from tests.tiny import SMALL
 
 
@@ -28,7 +28,12 @@ def test_the_film_thins_as_the_meniscus_nears_the_contact(cache):
     assert far["hc_over_hc_flooded"] == pytest.approx(1.0, abs=0.01)
     assert 0.3 < near["hc_over_hc_flooded"] < 0.97 * far["hc_over_hc_flooded"]
     assert starved_film(contact, 0.01) == near                      # held at the range's end
-    assert starved_film(contact, 0.52)["starved_meniscus_over_a"] == pytest.approx(0.5)
-    assert starved_film(contact, 1.6)["starved_meniscus_over_a"] == pytest.approx(1.5)
     assert starved_film(contact, None) == {"hc_over_hc_flooded": None,
                                            "starved_meniscus_over_a": None}
+
+
+def test_the_meniscus_is_held_within_the_range_and_rounded_coarser_far_out():
+    assert solved_meniscus(-0.4) == solved_meniscus(0.01) == MENISCUS_RANGE[0]
+    assert solved_meniscus(50.0) == MENISCUS_RANGE[1]
+    assert solved_meniscus(0.52) == 0.5 and solved_meniscus(0.98) == 1.0
+    assert solved_meniscus(1.6) == 1.5 and solved_meniscus(1.66) == 1.75

@@ -24,7 +24,7 @@ from ehlfoam.contact.spec import PrecalcSpec
 from ehlfoam.gap.source import PrecalcFailed, precalc_dir
 
 __all__ = ["MENISCUS_FAR", "MENISCUS_FAR_STEP", "MENISCUS_RANGE", "MENISCUS_STEP",
-           "starved_film"]
+           "solved_meniscus", "starved_film"]
 
 #: The meniscus distances [a] the starved solve is made at: nearer or farther ones are held
 #: at these ends (module docstring).
@@ -36,6 +36,16 @@ MENISCUS_RANGE = (0.05, 3.0)
 MENISCUS_STEP, MENISCUS_FAR, MENISCUS_FAR_STEP = 0.05, 1.0, 0.25
 
 
+def solved_meniscus(meniscus_over_a: float) -> float:
+    """The meniscus distance [a] the starved solve is made at for ``meniscus_over_a`` [a]:
+    held within :data:`MENISCUS_RANGE`, rounded to :data:`MENISCUS_STEP` below
+    :data:`MENISCUS_FAR` and to :data:`MENISCUS_FAR_STEP` beyond."""
+    lo, hi = MENISCUS_RANGE
+    d = min(max(float(meniscus_over_a), lo), hi)
+    step = MENISCUS_STEP if d < MENISCUS_FAR else MENISCUS_FAR_STEP
+    return round(round(d / step) * step, 6)
+
+
 def starved_film(contact: PrecalcSpec, meniscus_over_a: float | None) -> dict[str, Any]:
     """The film of ``contact`` with its inlet meniscus ``meniscus_over_a`` [a] upstream of
     x = -a: ``hc_over_hc_flooded`` (the central film over the flooded one on the same grid)
@@ -45,10 +55,7 @@ def starved_film(contact: PrecalcSpec, meniscus_over_a: float | None) -> dict[st
     none = {"hc_over_hc_flooded": None, "starved_meniscus_over_a": None}
     if meniscus_over_a is None or not abs(meniscus_over_a) < float("inf"):
         return none
-    lo, hi = MENISCUS_RANGE
-    d = min(max(float(meniscus_over_a), lo), hi)
-    step = MENISCUS_STEP if d < MENISCUS_FAR else MENISCUS_FAR_STEP
-    d = round(round(d / step) * step, 6)
+    d = solved_meniscus(meniscus_over_a)
     spec = contact.model_copy(update={"inlet_meniscus": d, "inlet_layer": None})
     try:
         folder = precalc_dir(spec)
