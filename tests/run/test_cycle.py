@@ -10,10 +10,6 @@ import csv
 import json
 import math
 import os
-import signal
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +22,7 @@ from ehlfoam.run.monitor import run_case
 from ehlfoam.spec.case import make_case_spec
 from ehlfoam.thinfilm.march import Marcher
 from ehlfoam.tracks.rig import Rig, Tracks
-from tests.run.test_thin_film import NO_FOAM
+from tests.run.test_thin_film import NO_FOAM, sigterm_run
 from tests.tiny import THIN_FILM
 from tests.tracks.test_rig import A, problem
 
@@ -169,20 +165,7 @@ def test_sigterm_ends_the_cycle_interrupted_and_it_goes_on_in_step(built, tmp_pa
     spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
     spec["cycle"] |= {"tolerance": 1e-15, "passes_max": 400}     # it runs on
     (case / "ehlfoam" / "spec.json").write_text(json.dumps(spec))
-    proc = subprocess.Popen([sys.executable, "-m", "ehlfoam", "run", str(case), "--quiet"],
-                            env={**os.environ, **NO_FOAM}, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
-    try:
-        deadline = time.monotonic() + 60
-        while not (case / "cycle.csv").exists() and time.monotonic() < deadline:
-            time.sleep(0.05)
-        time.sleep(0.3)
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=60) == 1
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+    assert sigterm_run(case, "cycle.csv", settle=0.3) == 1
     m = json.loads((case / "metrics.json").read_text())
     assert (m["status"], m["end_reason"]) == ("interrupted", "interrupted")
     made = len(_rows(case))

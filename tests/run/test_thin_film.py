@@ -76,6 +76,25 @@ def metrics(case: Path) -> dict:
     return json.loads((case / "metrics.json").read_text())
 
 
+def sigterm_run(case: Path, written: str, settle: float = 0.0) -> int:
+    """`ehlfoam run case` in its own process, sent SIGTERM once ``case/written`` exists
+    (and ``settle`` seconds more); its exit code."""
+    proc = subprocess.Popen([sys.executable, "-m", "ehlfoam", "run", str(case), "--quiet"],
+                            env={**os.environ, **NO_FOAM}, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while not (case / written).exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        time.sleep(settle)
+        proc.send_signal(signal.SIGTERM)
+        return proc.wait(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
 def test_a_thin_film_case_is_a_folder_without_openfoam_files(ran):
     names = {p.name for p in ran.iterdir()}
     assert {"ehlfoam", "precalc", "metrics.json", "history.csv", "state.npz",
@@ -183,19 +202,7 @@ def test_sigterm_ends_the_run_interrupted_with_its_state_written(ran, tmp_path):
     spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
     spec["run"]["steady_tolerance"] = 1e-9                   # never steady: it runs on
     (case / "ehlfoam" / "spec.json").write_text(json.dumps(spec))
-    proc = subprocess.Popen([sys.executable, "-m", "ehlfoam", "run", str(case), "--quiet"],
-                            env={**os.environ, **NO_FOAM}, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
-    try:
-        deadline = time.monotonic() + 60
-        while not (case / "history.csv").exists() and time.monotonic() < deadline:
-            time.sleep(0.1)
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=60) == 1          # not finished: metrics.json says why
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+    assert sigterm_run(case, "history.csv") == 1   # not finished: metrics.json says why
     m = metrics(case)
     assert (m["status"], m["end_reason"]) == ("interrupted", "interrupted")
     assert load_state(case / "state.npz").time == pytest.approx(m["simulated_time_s"])

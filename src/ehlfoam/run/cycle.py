@@ -51,7 +51,7 @@ from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run.fields import Sample
 from ehlfoam.run.history import write_history
 from ehlfoam.run.thin_film import (MARCH_ERRORS, STATE_FILE, advance, open_march,
-                                   sigterm_interrupts)
+                                   sigterm_interrupts, swapped_handlers)
 from ehlfoam.run.thin_film_record import Accounts, sample, thin_film_record
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.cycle import rig_layers
@@ -281,16 +281,8 @@ def _signals_held() -> Iterator[None]:
 
     def hold(signum: int, frame: object) -> None:
         caught.append(signum)
-    try:
-        old = {sig: signal.signal(sig, hold) for sig in (signal.SIGTERM, signal.SIGINT)}
-    except ValueError:
+    with swapped_handlers((signal.SIGTERM, signal.SIGINT), hold):
         yield
-        return
-    try:
-        yield
-    finally:
-        for sig, handler in old.items():
-            signal.signal(sig, handler)
     if caught:
         raise KeyboardInterrupt
 

@@ -52,7 +52,7 @@ from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state, save_state
 
 __all__ = ["FRAMES_DIR", "MARCH_ERRORS", "STATE_FILE", "advance", "open_march",
-           "run_thin_film_case", "sigterm_interrupts", "start_of"]
+           "run_thin_film_case", "sigterm_interrupts", "start_of", "swapped_handlers"]
 
 #: the state a thin-film run ends with, in the case folder
 STATE_FILE = "state.npz"
@@ -263,21 +263,31 @@ def advance(m: Marcher, steps: int = 1) -> None:
 
 
 @contextmanager
+def swapped_handlers(signals: tuple[int, ...], handler: Callable) -> Iterator[bool]:
+    """Within the block ``handler`` handles ``signals``; the handlers before are put back
+    after it. Yields whether they were swapped: not where handlers cannot be set (not the
+    main thread), and then nothing changes."""
+    try:
+        old = {sig: signal.signal(sig, handler) for sig in signals}
+    except ValueError:
+        yield False
+        return
+    try:
+        yield True
+    finally:
+        for sig, previous in old.items():
+            signal.signal(sig, previous)
+
+
+@contextmanager
 def sigterm_interrupts() -> Iterator[None]:
     """Within the block SIGTERM raises KeyboardInterrupt (the run ends ``interrupted``, its
     state written); the handler before is put back after it. Nothing changes where signals
     cannot be set (not the main thread)."""
     def interrupt(signum: int, frame: object) -> None:
         raise KeyboardInterrupt
-    try:
-        previous = signal.signal(signal.SIGTERM, interrupt)
-    except ValueError:
+    with swapped_handlers((signal.SIGTERM,), interrupt):
         yield
-        return
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 class _Log:
