@@ -188,3 +188,16 @@ def test_stability_maps_classify_every_point_and_compare_the_levels(tmp_path, tm
     (coarse, _) = rec["summary"]
     assert coarse["points"] == 2 and coarse["rest I"] + coarse["rest II"] == 2
     assert table_rows(stdout, "rung  points")[0][:3] == ["thin-film", "coarse", "2"]
+
+
+@pytest.mark.openfoam
+def test_static_meniscus_runs_a_resting_puddle_and_holds_it(tmp_path):
+    """The spurious-current benchmark's quick size: the 5 a puddle for 5 ms runs to its end,
+    its oil volume holds and its meniscus stays within a cell of where it started; the
+    gap-averaged speeds it prints are positive (the meniscus is still curving)."""
+    stdout, rec = run_bench("static_meniscus", tmp_path)
+    (row,) = rec["rows"]
+    assert row["status"] == "finished" and row["end_time_ms"] == pytest.approx(5.0)
+    assert abs(row["volume_change"]) < 1e-3 and abs(row["drift_a"]) < 0.2
+    assert 0.0 < row["settled_over_u"] <= row["late_over_u"]
+    assert table_rows(stdout, "configuration")[0][:3] == ["default", "step,", "5"]
