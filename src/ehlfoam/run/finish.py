@@ -1,7 +1,8 @@
 """The end of a 3D run, once its solver has exited: the writes past a steady stop removed, the
 reason it ended (where the watch found none: the solver's exit says it), and what it leaves in
-the case folder: ``metrics.json`` (:func:`ehlfoam.run.final.final_record`). The end reasons
-are listed in :mod:`ehlfoam.run.monitor`."""
+the case folder: ``outflow.csv`` (the layers its outlet's oil lays on the tracks,
+:mod:`ehlfoam.run.outflow`) and ``metrics.json`` (:func:`ehlfoam.run.final.final_record`).
+The end reasons are listed in :mod:`ehlfoam.run.monitor`."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run import fields as case_fields
 from ehlfoam.run.final import RunEnd, final_record
 from ehlfoam.run.history import write_history
+from ehlfoam.run.outflow import write_outflow
 from ehlfoam.run.start import START_FAILED, failure_from_log
 from ehlfoam.spec.case import CaseSpec
 
@@ -88,10 +90,16 @@ def write_end(case: Path, spec: CaseSpec, geom: CaseGeometry,
               structure: case_fields.Structure, *, initial_oil: float,
               history: list[case_fields.Sample], end: RunEnd, detail: str | None,
               logged_steps: int) -> MetricsRecord:
-    """Write what the run leaves: ``metrics.json``, the record of its ``history``
-    (``initial_oil`` [m3, whole contact]; ``detail``, where given, its reason). A record
-    that cannot be computed still says how the run ended (``logged_steps``: the time steps
-    the solver log shows). Returns the record."""
+    """Write what the run leaves, whatever its end: ``outflow.csv`` where it wrote a time
+    past the start (none without an outlet or a readable write), then ``metrics.json``, the
+    record of its ``history`` (``initial_oil`` [m3, whole contact]; ``detail``, where given,
+    its reason). A record that cannot be computed still says how the run ended
+    (``logged_steps``: the time steps the solver log shows). Returns the record."""
+    if history and history[-1].time > 0:
+        try:
+            write_outflow(case)
+        except Exception:  # noqa: BLE001 - no outlet or no readable time: no profile,
+            pass           # the record stands
     try:
         record = final_record(case, spec, geom, structure,
                               initial_oil=initial_oil, history=history, end=end)
