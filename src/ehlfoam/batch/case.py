@@ -25,7 +25,7 @@ from ehlfoam.batch.plan import PlannedCase, load_plan
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 
 #: How long a worker waits for a case still held by a stopping process (the solver's
-#: graceful stop takes up to ehlfoam.run.monitor.STOP_GRACE_S = 120 s).
+#: graceful stop takes up to ehlfoam.run.watch.STOP_GRACE_S = 120 s).
 LOCK_WAIT_S = 180.0
 
 _PLAN_CACHE: dict[str, tuple[tuple, dict[str, PlannedCase]]] = {}

@@ -11,7 +11,6 @@ from ehlfoam.notices import to_text
 from ehlfoam.metrics.record import MetricsRecord
 from ehlfoam.run import fields as case_fields
 from ehlfoam.run.balance import dissolved_air_budget, mass_balance
-from ehlfoam.run.outflow import write_outflow
 from ehlfoam.run.warnings import (boundary_warnings, front_cell_warnings,
                                   front_contact_line_cells, rear_cell_warnings,
                                   rear_meniscus_cell)
@@ -48,15 +47,9 @@ def final_record(case: Path, spec: CaseSpec, geom: CaseGeometry,
                  structure: case_fields.Structure, *, initial_oil: float,
                  history: list[case_fields.Sample], end: RunEnd) -> MetricsRecord:
     """The run's metrics record from its ``history`` of samples (``initial_oil``: the oil
-    volume at t = 0 [m3, whole contact]); the layers its outflow lays on the tracks go to
-    ``outflow.csv`` (:func:`ehlfoam.run.outflow.write_outflow`, where it has an outlet and a
-    written time)."""
+    volume at t = 0 [m3, whole contact]). Writes nothing: it reads the case's last write
+    and, for a failed run, its solver log."""
     last = history[-1] if history else None
-    if last is not None and last.time > 0:
-        try:
-            write_outflow(case)
-        except Exception:  # noqa: BLE001 - no outlet or no readable time: no profile,
-            pass           # the record stands
     pattern = dict(last.pattern) if last else {}
     off_outlet = case_fields.off_outlet_share(last.oil_out_by_boundary) if last else None
     # where oil fills the domain (single-phase scene, submerged supply) it meets every

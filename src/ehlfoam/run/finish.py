@@ -1,0 +1,114 @@
+"""The end of a 3D run, once its solver has exited: the writes past a steady stop removed, the
+reason it ended (where the watch found none: the solver's exit says it), and what it leaves in
+the case folder: ``outflow.csv`` (the layers its outlet's oil lays on the tracks,
+:mod:`ehlfoam.run.outflow`) and ``metrics.json`` (:func:`ehlfoam.run.final.final_record`).
+The end reasons are listed in :mod:`ehlfoam.run.monitor`."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from ehlfoam.case.geometry import CaseGeometry
+from ehlfoam.metrics.record import MetricsRecord, write_metrics
+from ehlfoam.run import fields as case_fields
+from ehlfoam.run.final import RunEnd, final_record
+from ehlfoam.run.history import write_history
+from ehlfoam.run.outflow import write_outflow
+from ehlfoam.run.start import START_FAILED, failure_from_log
+from ehlfoam.spec.case import CaseSpec
+
+__all__ = ["CASE_REMOVED", "MONITOR_ERROR", "end_reason", "one_line", "removed_record",
+           "trim_past_stop", "write_end"]
+
+CASE_REMOVED = "case_removed"
+MONITOR_ERROR = "monitor_error"
+
+
+def one_line(err: BaseException) -> str:
+    """``err`` as one line of at most 500 characters, its type first."""
+    return f"{type(err).__name__}: {' '.join(str(err).split())}"[:500]
+
+
+def removed_record(case: Path, geom: CaseGeometry, time_steps: int,
+                   wall_s: float) -> MetricsRecord:
+    """The record of a run whose case folder was removed (or replaced) while it ran; nothing
+    is written (there is no folder to write to). ``wall_s`` [s]."""
+    return MetricsRecord(status="failed", end_reason=CASE_REMOVED, cells=geom.cells,
+                         time_steps=time_steps, wall_s=wall_s,
+                         reason=f"the case folder {case} was removed (or replaced) "
+                                "while it ran: the solver was stopped, nothing written")
+
+
+def trim_past_stop(case: Path, history: list[case_fields.Sample],
+                   stop_at: float) -> list[case_fields.Sample]:
+    """Remove the writes a solver faster than the poll made past the steady stop at
+    ``stop_at`` [s] (before it saw the new endTime), from the history too (history.csv
+    rewritten where that changed it): the run ends at the stop. Returns the history kept."""
+    t = stop_at * (1.0 + 1e-9)
+    past = [folder for u, folder in case_fields.time_folders(case) if u > t]
+    for proc in sorted(case.glob("processor*")):
+        past += [folder for u, folder in case_fields.time_folders(proc) if u > t]
+    for folder in past:
+        shutil.rmtree(folder, ignore_errors=True)
+    kept = [s for s in history if s.time <= t]
+    if len(kept) != len(history):
+        write_history(case, kept)
+    return kept
+
+
+def end_reason(reason: str | None, detail: str | None, *, exit_code: int | None,
+               logged_steps: int, case: Path, geom: CaseGeometry
+               ) -> tuple[str, bool, str | None]:
+    """The run's end reason, whether it failed, and the words that say why (``detail``
+    unless the end is found only now). ``reason``: the one the watch found, or None: then
+    the solver's ``exit_code`` says it (0: ``end_time``; no time step logged:
+    ``start_failed``, with the log's words; otherwise ``diverged``)."""
+    if reason is None:
+        if exit_code == 0:
+            reason = "end_time"
+        elif logged_steps == 0:
+            reason = START_FAILED
+            detail = (f"{geom.solver} stopped before its first time step (exit code "
+                      f"{exit_code}): {_log_reason(case, geom)}")
+        else:
+            reason = "diverged"
+    failed = reason in ("diverged", START_FAILED, MONITOR_ERROR) or (
+        exit_code not in (0, None, -9) and reason != "interrupted")
+    return reason, failed, detail
+
+
+def _log_reason(case: Path, geom: CaseGeometry) -> str:
+    try:
+        text = (case / geom.log_name).read_text(errors="replace")
+    except OSError:
+        return "no solver log"
+    return failure_from_log(text) or "an empty solver log"
+
+
+def write_end(case: Path, spec: CaseSpec, geom: CaseGeometry,
+              structure: case_fields.Structure, *, initial_oil: float,
+              history: list[case_fields.Sample], end: RunEnd, detail: str | None,
+              logged_steps: int) -> MetricsRecord:
+    """Write what the run leaves, whatever its end: ``outflow.csv`` where it wrote a time
+    past the start (none without an outlet or a readable write), then ``metrics.json``, the
+    record of its ``history`` (``initial_oil`` [m3, whole contact]; ``detail``, where given,
+    its reason). A record that cannot be computed still says how the run ended
+    (``logged_steps``: the time steps the solver log shows). Returns the record."""
+    if history and history[-1].time > 0:
+        try:
+            write_outflow(case)
+        except Exception:  # noqa: BLE001 - no outlet or no readable time: no profile,
+            pass           # the record stands
+    try:
+        record = final_record(case, spec, geom, structure,
+                              initial_oil=initial_oil, history=history, end=end)
+    except Exception as err:  # noqa: BLE001 - still say how the run ended
+        record = MetricsRecord(status=end.status, end_reason=end.reason, cells=geom.cells,
+                               solver_exit_code=end.exit_code, time_steps=logged_steps,
+                               wall_s=end.wall_s,
+                               reason=f"metrics could not be computed: {one_line(err)}")
+    if detail:
+        record = record.updated(reason=detail)
+    write_metrics(case, record)
+    return record
