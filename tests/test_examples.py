@@ -1,8 +1,8 @@
 """The example specs users start from: every one is valid (tests/batch/test_spec.py), every case
 spec builds with a small precalc grid, and the short ones run, cut short: a coarse mesh and a
-few hundredths of a transit (the run's own settings otherwise). The cases of tens of thousands
-of cells (the film-resolving boxes, the levels that follow the meniscus) are built only: a run
-of theirs takes minutes even cut short. nominal_resolved.toml's mesh follows a start state's
+few hundredths of a transit, a stop of milliseconds (the run's own settings otherwise). The
+cases of tens of thousands of cells (the film-resolving boxes, the levels that follow the
+meniscus) are built only: a run of theirs takes minutes even cut short. nominal_resolved.toml's mesh follows a start state's
 meniscus, so it is built from a thin-film state the test makes first."""
 
 from __future__ import annotations
@@ -39,6 +39,9 @@ def test_every_example_case_builds_and_runs(spec: Path, tmp_path: Path) -> None:
                         "--transits", "0.5", "--quiet", cwd=tmp_path)
         assert made.returncode == 0, made.stderr
         start = ["--start-from", "tf/state.npz"]
+    if "[stop]" in spec.read_text():          # the stop sets the end: a short one
+        start += ["--set", "stop.at=0.002", "--set", "stop.duration=0.001",
+                  "--set", "stop.after=0.001", "--set", "stop.frames_from=0"]
     case = _ehlfoam("case", str(spec), "--out", "case", *SHORT, *start, cwd=tmp_path)
     assert case.returncode == 0, case.stderr
     geometry = json.loads((tmp_path / "case" / "ehlfoam" / "geometry.json").read_text())

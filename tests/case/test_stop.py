@@ -1,7 +1,7 @@
 """The walls' stop in a real (tiny) OpenFOAM case (issue 76 part 5): the disc, the ball, the
 island and the supply slow as wall_speed_at says, read back from the velocity OpenFOAM wrote
 at each time before, during and after the ramp; the steady-state test does not end the run
-before the stop's end."""
+before the stop's end; the report's stop pictures take a frame from each written time."""
 
 from __future__ import annotations
 
@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 from foamlib import FoamFieldFile
 
+from ehlfoam.case.geometry import load_geometry
 from ehlfoam.case.writer import write_case
+from ehlfoam.report.stop import make_stop_pictures
 from ehlfoam.errors import SpecError
 from ehlfoam.run import fields as case_fields
 from ehlfoam.run.monitor import run_case
@@ -53,6 +55,15 @@ def test_the_walls_of_a_3d_case_slow_to_rest_as_the_stop_says(tmp_path, scene):
             assert v == pytest.approx(k * v0, abs=1e-6 * u), (patch, t)   # 8 digits written
     assert min(phases.values()) >= 2, phases
     assert np.abs(base["island"]).max() > 0.5 * u and np.abs(base["ball"]).max() > 0.5 * u
+    # the report's stop pictures: a frame a written time, labelled from the stop
+    gif, png, recs = make_stop_pictures(case, load_geometry(case), spec.stop, spec.speed,
+                                        tmp_path, written=True)
+    assert gif.is_file() and png.is_file()
+    assert [r["time_s"] for r in recs] == pytest.approx([t for t, _ in times])
+    for r in recs:
+        assert r["from_stop_s"] == pytest.approx(r["time_s"] - STOP["at"])
+        assert r["wall_speed_m_s"] == pytest.approx(wall_speed_at(spec.stop, u, r["time_s"]))
+        assert r["state"] in ("I", "II") and r["flooded_length_over_a"] > 0
 
 
 def test_a_stop_with_slip_walls_or_still_walls_is_refused():

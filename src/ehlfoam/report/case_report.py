@@ -214,9 +214,9 @@ def _report_case(case_dir: str | os.PathLike, animate: bool, gif_frames: int) ->
     settle = steps.run("history chart", _history, info, out, page)
     if animate and fields is not None and not thin:
         steps.run("transient GIF", _gif, info, fields, out, page, gif_frames)
-    if animate and thin and info.geom is not None and info.spec is not None \
-            and info.spec.stop.at is not None:
-        steps.run("stop GIF", _stop, info, out, page)
+    if animate and info.geom is not None and info.spec is not None \
+            and info.spec.stop.at is not None and (thin or fields is not None):
+        steps.run("stop GIF", _stop, info, out, page, not thin)
     if summary_top:
         page.summary.extend(summary_top)
     if info.metrics and fields is not None:
@@ -371,17 +371,23 @@ def _gif(info: CaseInfo, fields, out: Path, page: Page, max_frames: int) -> None
                                    "alpha = 0.5 meniscus."))
 
 
-def _stop(info: CaseInfo, out: Path, page: Page) -> None:
+def _stop(info: CaseInfo, out: Path, page: Page, written: bool) -> None:
+    """The stop's GIF, strip and summary: a thin-film run's kept states, or (``written``) a
+    3D run's written times."""
     from ehlfoam.report.stop import make_stop_pictures
 
     stop = info.spec.stop
-    gif, png, recs = make_stop_pictures(info.path, info.geom, stop, info.spec.speed, out)
+    gif, png, recs = make_stop_pictures(info.path, info.geom, stop, info.spec.speed, out,
+                                        written)
     if gif is None:
-        page.summary.append("No frames of the stop yet (DIR/frames/): no stop GIF.")
+        page.summary.append("No frames of the stop yet ("
+                            + ("written times" if written else "DIR/frames/")
+                            + "): no stop GIF.")
         return
+    every = ("at each write" if written
+             else f"a frame every {stop.frame_interval * 1e3:g} ms")
     page.figures.append(Figure(
-        "stop.gif", "The sudden stop (a frame every "
-        f"{stop.frame_interval * 1e3:g} ms)",
+        "stop.gif", f"The sudden stop ({every})",
         f"The walls slow from {info.spec.speed * 1e3:g} mm/s to rest over "
         f"{stop.duration * 1e3:g} ms from t = {stop.at * 1e3:g} ms; the model's oil as a "
         "mid-gap oil fraction (amber: flooded; pale: air, the bubble's gas inside the "

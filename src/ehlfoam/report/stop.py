@@ -1,10 +1,11 @@
 """The sudden stop's pictures: a thin-film run with a ``[stop]`` keeps its state every
-``stop.frame_interval`` in ``DIR/frames/`` (:mod:`ehlfoam.run.thin_film`); this draws them as
-the top view's raster (the metrics' own, as :mod:`ehlfoam.report.animation` draws a 3D
-case's written times), labelled with the time from the stop, the walls' speed
-(:func:`~ehlfoam.spec.stop.wall_speed_at`) and what the metrics read (state, bubble, the
-region's length and width), into a GIF and a strip of six frames (PNG), and lists each
-frame's reading (:func:`stop_frames`).
+``stop.frame_interval`` in ``DIR/frames/`` (:mod:`ehlfoam.run.thin_film`), a 3D run writes
+its fields ``run.writes_per_transit`` times a transit; this draws each frame (a kept state
+or a written time) as the top view's raster (the metrics' own, as
+:mod:`ehlfoam.report.animation` draws a 3D case's written times), labelled with the time
+from the stop, the walls' speed (:func:`~ehlfoam.spec.stop.wall_speed_at`) and what the
+metrics read (state, bubble, the region's length and width), into a GIF and a strip of six
+frames (PNG), and lists each frame's reading (:func:`stop_frames`).
 """
 
 from __future__ import annotations
@@ -32,36 +33,57 @@ def _frame_files(case: Path) -> list[Path]:
     return sorted((Path(case) / FRAMES_DIR).glob("[0-9][0-9][0-9][0-9].npz"))
 
 
-def stop_frames(case: str | Path, geom: CaseGeometry, stop: Stop, speed: float
-                ) -> list[dict]:
-    """Each frame's reading: ``file``, ``time_s`` (run time), ``from_stop_s`` (time from the
-    start of the deceleration), ``wall_speed_m_s``, the metrics' ``state``,
-    ``bubble_length_over_a``, ``bubble_enclosed``, ``flooded_length_over_a``,
-    ``flooded_width_over_a``, ``cavities`` (the enclosed gas pockets, cells) and
-    ``cavity_cells``."""
+def _thin_film_frames(case: Path, geom: CaseGeometry):
+    """(run time [s], raster, pattern, enclosed gas pockets, their cells) of each state a
+    thin-film run kept in ``DIR/frames/``."""
     from scipy import ndimage
 
-    out = []
-    for f in _frame_files(Path(case)):
+    for f in _frame_files(case):
         sol = load_state(f)
         fields = ThinFilmFields(time=sol.time, folder=f, geom=geom, sol=sol)
-        p = fields.pattern
         cav = np.zeros(sol.flooded.shape, bool) if sol.cavity is None else sol.cavity
-        out.append({"file": f.name, "time_s": sol.time,
-                    "from_stop_s": sol.time - (stop.at or 0.0),
-                    "wall_speed_m_s": float(wall_speed_at(stop, speed, sol.time)),
+        yield (sol.time, fields.raster, fields.pattern, int(ndimage.label(cav)[1]),
+               int(cav.sum()))
+
+
+def _written_frames(case: Path, geom: CaseGeometry):
+    """The same of each time a 3D run wrote: the enclosed bubbles the metrics count, the
+    raster's pixels of enclosed gas not counted (None)."""
+    from ehlfoam.metrics import pattern as flow
+    from ehlfoam.run import fields as case_fields
+
+    structure = case_fields.Structure.load(case)
+    for t, folder in case_fields.time_folders(case):
+        mid = case_fields.mid_gap_alpha(folder, structure, geom)
+        raster = case_fields.column_raster(mid, structure, geom)
+        pattern = flow.flow_pattern_from_raster(raster)
+        yield t, raster, pattern, int(pattern.get("enclosed_bubbles") or 0), None
+
+
+def stop_frames(case: str | Path, geom: CaseGeometry, stop: Stop, speed: float,
+                written: bool = False) -> list[dict]:
+    """Each frame's reading: ``time_s`` (run time), ``from_stop_s`` (time from the start of
+    the deceleration), ``wall_speed_m_s``, the metrics' ``state``,
+    ``bubble_length_over_a``, ``bubble_enclosed``, ``flooded_length_over_a``,
+    ``flooded_width_over_a``, ``cavities`` (the enclosed gas pockets) and ``cavity_cells``
+    (their cells; None for a 3D run). The frames: the states a thin-film run kept, or with
+    ``written`` a 3D run's written times."""
+    frames = (_written_frames if written else _thin_film_frames)(Path(case), geom)
+    out = []
+    for t, raster, p, pockets, cells in frames:
+        out.append({"time_s": t, "from_stop_s": t - (stop.at or 0.0),
+                    "wall_speed_m_s": float(wall_speed_at(stop, speed, t)),
                     "state": p.get("state"),
                     "bubble_length_over_a": p.get("bubble_length_over_a"),
                     "bubble_enclosed": p.get("bubble_enclosed"),
                     "flooded_length_over_a": p.get("flooded_length_over_a"),
                     "flooded_width_over_a": p.get("flooded_width_over_a"),
-                    "cavities": int(ndimage.label(cav)[1]), "cavity_cells": int(cav.sum()),
-                    "_fields": fields})
+                    "cavities": pockets, "cavity_cells": cells, "_raster": raster})
     return out
 
 
 def _image(rec: dict):
-    r = rec["_fields"].raster
+    r = rec["_raster"]
     bub = rec["bubble_length_over_a"]
     text = (f"{rec['from_stop_s'] * 1e3:+6.1f} ms from the stop  u = "
             f"{rec['wall_speed_m_s'] * 1e3:.2f} mm/s  state {rec['state']}  bubble "
@@ -71,17 +93,19 @@ def _image(rec: dict):
 
 
 def make_stop_pictures(case: str | Path, geom: CaseGeometry, stop: Stop, speed: float,
-                       out: str | Path) -> tuple[Path | None, Path | None, list[dict]]:
+                       out: str | Path, written: bool = False
+                       ) -> tuple[Path | None, Path | None, list[dict]]:
     """``out/stop.gif`` (every frame, thinned evenly to :data:`MAX_FRAMES`) and
     ``out/stop_frames.png`` (the frames nearest :data:`STRIP_TIMES` from the stop, side by
     side in two rows) of the stopping run in ``case``, and each frame's reading
-    (:func:`stop_frames`, without the fields). (None, None, []) without frames."""
+    (:func:`stop_frames`, without the rasters; ``written``: a 3D run's written times).
+    (None, None, []) without frames."""
     from PIL import Image
 
     out = Path(out)
-    recs = stop_frames(case, geom, stop, speed)
+    recs = stop_frames(case, geom, stop, speed, written)
     if len(recs) < 2:
-        return None, None, [{k: v for k, v in r.items() if k != "_fields"} for r in recs]
+        return None, None, [{k: v for k, v in r.items() if k != "_raster"} for r in recs]
     pick = np.unique(np.linspace(0, len(recs) - 1, min(MAX_FRAMES, len(recs))).round()
                      .astype(int))
     frames = [_image(recs[k]) for k in pick]
@@ -97,4 +121,4 @@ def make_stop_pictures(case: str | Path, geom: CaseGeometry, stop: Stop, speed: 
         sheet.paste(tile, ((i % cols) * w, (i // cols) * h))
     png = out / "stop_frames.png"
     sheet.save(png)
-    return gif, png, [{k: v for k, v in r.items() if k != "_fields"} for r in recs]
+    return gif, png, [{k: v for k, v in r.items() if k != "_raster"} for r in recs]
