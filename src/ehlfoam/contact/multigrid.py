@@ -7,8 +7,9 @@ zero-gradient outlet) and the film constant H0. Equations on every level:
     film      H = H0 + X^2/2 + Y^2/2 + W(P) + tauW   (W by DC-FFT, :mod:`ehlfoam.contact.elastic`)
     load      h^2 sum(P) = target
 
-On the finest level f = 0, tauW = 0 and target = 2 pi / 3. The coarse levels carry the FAS
-right-hand sides (restricted residual plus coarse operator of the injected pressure), the
+On the finest level f = 0, tauW = 0 and target = 2 pi / 3 (unless a load is held there,
+:meth:`MultigridSolver.hold`: tauW is its deformation, the target less its load). The coarse
+levels carry the FAS right-hand sides (restricted residual plus coarse operator of the injected pressure), the
 FAS correction of the film (fine deformation minus coarse deformation of the injected
 pressure) and of the load. H0 is relaxed against the load on the coarsest level, whose
 problem is solved (rounds of sweeps and H0 steps). Full multigrid (FMG) start from a
@@ -81,6 +82,9 @@ class MultigridSolver:
         self.levels = [Level(n1, n2, dom.x_min, -dom.y_half, hh, self.workers)
                        for n1, n2, hh in reversed(sizes)]
         self.H0 = 0.0
+        #: a load held on the finest level (see :meth:`hold`): its deformation and load
+        self.held_W: np.ndarray | None = None
+        self.held_load = 0.0
         # the film constant reacts strongly to the load when heavily loaded: smaller steps
         self.h0_gain = self.opt.h0_gain * (0.25 if prob.moes_M > 1000.0 else 1.0)
 
@@ -168,11 +172,28 @@ class MultigridSolver:
         return int(np.argmin(np.abs(lv.y))), int(np.argmin(np.abs(lv.x)))
 
     # --- driver ---------------------------------------------------------------------------
-    def solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
+    def hold(self, P_held: np.ndarray | None) -> None:
+        """Hold a given pressure field (units pH, finest grid; None: none) as an external load
+        in the next solves: its elastic deformation is added to the finest level's film (the
+        coarse levels get it through their FAS film correction) and its load is taken off the
+        finest level's load target, so that the solved P plus ``P_held`` carries the load.
+        The two-phase option's sub-ambient field, coupled back
+        (:mod:`ehlfoam.contact.coupled`)."""
+        if P_held is None or not np.any(P_held):
+            self.held_W, self.held_load = None, 0.0
+            return
+        top = self.levels[-1]
+        self.held_W = top.deform(P_held)
+        self.held_load = top.load(P_held)
+
+    def solve(self, H0_guess: float, P_init: np.ndarray | None = None,
+              fmg_hc: list | None = None) -> MGResult:
         """Solve from a Hertzian start by FMG, or from ``P_init`` (finest grid) by cycles,
-        on :attr:`workers` threads."""
+        on :attr:`workers` threads. ``fmg_hc``: the FMG levels' central films of an earlier
+        solve of the same problem, for the film tolerance of a solve from ``P_init``
+        (:meth:`film_tolerance`; default: none, the loosest)."""
         with numba_threads(self.workers):
-            return self._solve(H0_guess, P_init)
+            return self._solve(H0_guess, P_init, fmg_hc)
 
     def _fmg(self) -> list[float]:
         """Full multigrid start: the coarsest level from a Hertzian pressure, then each finer
@@ -227,7 +248,8 @@ class MultigridSolver:
         tol = opt.film_fraction * abs(hc - hc_coarse) / 3.0
         return float(np.clip(tol, opt.film_rel_min * abs(hc), top))
 
-    def _solve(self, H0_guess: float, P_init: np.ndarray | None = None) -> MGResult:
+    def _solve(self, H0_guess: float, P_init: np.ndarray | None = None,
+               fmg_hc_given: list | None = None) -> MGResult:
         t0 = time.perf_counter()
         base_opt = self.opt
         if self.prob.moes_L > base_opt.high_L:
@@ -240,9 +262,12 @@ class MultigridSolver:
         if P_init is not None:
             self.levels[-1].P = P_init.copy()
             self._enforce_bc(self.levels[-1])
-            fmg_hc = []
+            fmg_hc = list(fmg_hc_given or [])
         else:
             fmg_hc = self._fmg()
+        top_lv = self.levels[-1]  # the held load (FMG and a fresh start leave it out)
+        top_lv.tauW = np.zeros_like(top_lv.P) if self.held_W is None else self.held_W.copy()
+        top_lv.load_target = LOAD_TARGET - self.held_load
         top = len(self.levels) - 1
         lv = self.levels[-1]
         j, i = self._centre(top)
