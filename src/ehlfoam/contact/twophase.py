@@ -30,9 +30,9 @@ to ``tol``, so the result is the fine grid's own discrete solution.
 Started from an earlier solution instead (``P_start``: the coupled option's later passes,
 :mod:`ehlfoam.contact.coupled`, where the film has changed by a percent or less), the fine
 grid is solved alone, every step's GMRES preconditioned by the first step's LU (refactored
-only where the unknown points change or GMRES does not converge): the same steps, one
-factorisation. (In the nested iteration an earlier step's LU measured slower: 2.5x the CPU
-time on 513 x 257.)
+only where the unknown points change or GMRES does not converge in a few iterations): the
+same steps, one or two factorisations. (In the nested iteration an earlier step's LU saves
+nothing: 8 of 9 fine steps on 513 x 257 still needed their own.)
 """
 
 from __future__ import annotations
@@ -61,6 +61,9 @@ INTERIOR_FRACTION = 0.9
 KRYLOV_RTOL = 1e-6
 KRYLOV_RESTART = 30
 KRYLOV_RESTARTS = 2
+#: GMRES preconditioned by an earlier step's LU gives up after this many iterations (then the
+#: step's own LU)
+REUSED_LU_ITERATIONS = 10
 
 
 @dataclass
@@ -197,7 +200,8 @@ def _factor(J: sp.csc_matrix):
         return spla.splu(J)
 
 
-def _gmres(J: sp.csr_matrix, b: np.ndarray, lu) -> tuple[np.ndarray | None, int]:
+def _gmres(J: sp.csr_matrix, b: np.ndarray, lu, restart: int = KRYLOV_RESTART,
+           restarts: int = KRYLOV_RESTARTS) -> tuple[np.ndarray | None, int]:
     """GMRES on J x = b preconditioned by ``lu``: (x or None if not converged, iterations)."""
     count = [0]
 
@@ -205,22 +209,24 @@ def _gmres(J: sp.csr_matrix, b: np.ndarray, lu) -> tuple[np.ndarray | None, int]
         count[0] += 1
 
     x, info = spla.gmres(J, b, M=spla.LinearOperator(J.shape, lu.solve), rtol=KRYLOV_RTOL,
-                         restart=KRYLOV_RESTART, maxiter=KRYLOV_RESTARTS, callback=tick,
+                         restart=restart, maxiter=restarts, callback=tick,
                          callback_type="pr_norm")
     return (x if info == 0 else None), count[0]
 
 
 def _newton(P: np.ndarray, P0: np.ndarray, H: np.ndarray, h: float, prob: Problem,
             free: np.ndarray, tol: float, max_iter: int, refined: bool,
-            keep_lu: bool = False) -> tuple:
+            keep_lu: float = 0.0) -> tuple:
     """Damped Newton from P on the ``free`` points. ``refined``: a start interpolated from a
     coarser solution (steps held inside the vacuum bound; each step's system by GMRES
     preconditioned by its own LU without pivoting, :func:`_factor`); else each step's own
     LU (scipy's default, partial pivoting) and a plain projection onto P >= vacuum.
-    ``keep_lu`` (refined only): GMRES preconditioned by the last LU while the unknown points
-    are the same and it converges (a start close to the solution: the coupled option's later
-    passes, one LU instead of six); a new LU where not. Returns (P, converged, iterations,
-    residual, factorisations, GMRES iterations)."""
+    ``keep_lu`` (refined only): while the residual is below it, GMRES preconditioned by the
+    last LU as long as the unknown points are the same and it converges in
+    :data:`REUSED_LU_ITERATIONS` (a start close to the solution, ``inf``: the coupled
+    option's later passes, one or two LUs instead of four to six); a new LU where not (0:
+    always; in the nested iteration a reused LU measured no faster). Returns (P, converged,
+    iterations, residual, factorisations, GMRES iterations)."""
     r = np.zeros_like(P)
     wedge = np.zeros_like(P)
     f0 = np.zeros_like(P)
@@ -253,16 +259,20 @@ def _newton(P: np.ndarray, P0: np.ndarray, H: np.ndarray, h: float, prob: Proble
         J = _jacobian(P, H, rho, drho, eps, h, unknown, _eps_slope(P, H, drho, prob))
         b = r[unknown]
         x = None
-        if refined and keep_lu and lu is not None and np.array_equal(lu_of, unknown):
-            x, n = _gmres(J, b, lu)  # an earlier step's LU: refactored if GMRES fails
+        if refined and res < keep_lu and lu is not None and np.array_equal(lu_of, unknown):
+            # an earlier step's LU: refactored if GMRES does not converge in a few iterations
+            x, n = _gmres(J, b, lu, REUSED_LU_ITERATIONS, 1)
             n_krylov += n
         if refined and x is None:
+            lu = None  # released before the next factorisation (one LU in memory at a time)
             try:
                 lu, lu_of = _factor(J.tocsc()), unknown.copy()
                 x, n = _gmres(J, b, lu)
             except RuntimeError:  # singular: the direct solve below says so
                 lu, x, n = None, None, 0
             n_lu, n_krylov = n_lu + 1, n_krylov + n
+            if not keep_lu:
+                lu = None
         if x is None:  # a direct solve: scipy's LU with partial pivoting
             n_lu += 1
             try:
@@ -337,7 +347,8 @@ def solve_subambient(P0: np.ndarray, H: np.ndarray, h: float, prob: Problem,
             start[:, -1] = start[:, -2]
         P, ok, its, res, n_lu, n_krylov = _newton(start, p0, hh, s, prob, _free(p0, p_fixed),
                                                   tol, max_iter, refined,
-                                                  keep_lu=P_start is not None)
+                                                  keep_lu=np.inf if P_start is not None
+                                                  else 0.0)
         levels.append(dict(shape=list(p0.shape), iterations=its, factorisations=n_lu,
                            krylov_iterations=n_krylov, residual=res, converged=ok,
                            wall_s=time.perf_counter() - t0))
