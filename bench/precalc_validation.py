@@ -16,9 +16,11 @@
 4. The two-phase cavitation option at 20 mm/s, 25 C, 20 N on 257 points along y (513 x
    257): the sub-ambient length and the more-than-half-gas length over a, beside the thesis
    model's 0.9 a; with ``--twophase``, on three grids up to its default (2049 x 1025),
-   each with its wall and CPU time, the part of it in the sub-ambient solve, the Newton
-   iterations on each grid of its nested iteration (coarsest first), peak memory and the
-   machine's load average.
+   each fully coupled and one-way: hc, hmin, the lengths, how well each satisfies the coupled
+   equations (film error over hc, load error), the outer iterations, wall and CPU time, the
+   part of it in the sub-ambient solves, the Newton iterations on each grid of its nested
+   iteration (coarsest first) or of its last pass, peak memory and the machine's load
+   average; then the one-way's error against the coupled on each grid.
 5. With ``--stability``: converged / stagnated / failed over M = 10..3e4 x L = 0..20 on
    ``--stability-grid`` points a side (``default``: the solver's own grid).
 6. With ``--accuracy``: the 18-point table (5 / 20 / 30 N x 25 / 40 / 60 C, each at 10 mm/s
@@ -115,33 +117,72 @@ def accuracy(workers: int | None) -> dict:
                 workers=workers)
 
 
-def twophase(grids: tuple[int, ...], workers: int | None) -> list[dict]:
-    """The two-phase option at 20 mm/s, 25 C, 20 N on ``grids`` (points along y; x has
-    2n - 1): sub-ambient and more-than-half-gas lengths over a, time and peak memory."""
+def twophase(grids: tuple[int, ...], workers: int | None,
+             couplings: tuple[str, ...] = ("coupled", "one-way"), load: float = 20.0,
+             speed: float = 0.02, temperature: float = 25.0) -> list[dict]:
+    """The two-phase option at 20 mm/s, 25 C, 20 N (default) on ``grids`` (points along y; x
+    has 2n - 1), each coupling of ``couplings``: hc, hmin, sub-ambient and more-than-half-gas
+    lengths over a, the coupled equations' errors (film over hc, load), outer iterations,
+    time and peak memory; a one-way row also its error against the coupled row of its grid
+    (hc, hmin relative, lengths in a)."""
     rows = []
     for n in grids:
-        s = solve_in_subprocess(dict(load=20.0, speed=0.02, temperature=25.0,
-                                     cavitation="twophase", grid=n), workers=workers)
-        levels = s.get("subambient_levels") or []
-        rows.append(dict(grid=s.get("grid", n), converged=bool(s["converged"]),
-                         cavity_over_a=s.get("cavity_length_over_a"),
-                         half_gas_over_a=s.get("cavity_half_density_length_over_a"),
-                         reaches_outlet=s.get("cavity_reaches_outlet"),
-                         p_min_Pa=s.get("p_min_Pa"), wall_s=s["wall_s"], cpu_s=s["cpu_s"],
-                         subambient_s=sum(lv["wall_s"] for lv in levels) if levels else None,
-                         newton="/".join(str(lv["newton_iterations"]) for lv in levels),
-                         factorisations=sum(lv["factorisations"] for lv in levels),
-                         levels=levels, peak_GiB=s["peak_rss_GiB"],
-                         load=s.get("load_average", [None])[0], failure=s.get("failure")))
+        for coupling in couplings:
+            s = solve_in_subprocess(dict(load=load, speed=speed, temperature=temperature,
+                                         cavitation="twophase", grid=n,
+                                         twophase_coupling=coupling), workers=workers)
+            levels = s.get("subambient_levels") or []
+            rows.append(dict(grid=s.get("grid", n), coupling=coupling,
+                             converged=bool(s["converged"]),
+                             hc_nm=s["hc_m"] * 1e9 if s.get("hc_m") else None,
+                             hmin_nm=s["hmin_m"] * 1e9 if s.get("hmin_m") else None,
+                             cavity_over_a=s.get("cavity_length_over_a"),
+                             half_gas_over_a=s.get("cavity_half_density_length_over_a"),
+                             reaches_outlet=s.get("cavity_reaches_outlet"),
+                             film_error=s.get("coupling_film_error_over_hc"),
+                             load_error=s.get("coupling_load_error"),
+                             outer=s.get("coupling_outer_iterations"),
+                             p_min_Pa=s.get("p_min_Pa"), wall_s=s["wall_s"], cpu_s=s["cpu_s"],
+                             subambient_s=sum(lv["wall_s"] for lv in levels) if levels else None,
+                             newton="/".join(str(lv["newton_iterations"]) for lv in levels),
+                             factorisations=sum(lv["factorisations"] for lv in levels),
+                             levels=levels, coupling_outer=s.get("coupling_outer"),
+                             peak_GiB=s["peak_rss_GiB"],
+                             load=s.get("load_average", [None])[0], failure=s.get("failure")))
+    coupled = {r["grid"][1] if isinstance(r["grid"], list) else r["grid"]: r
+               for r in rows if r["coupling"] == "coupled" and r["converged"]}
+    for r in rows:
+        c = coupled.get(r["grid"][1] if isinstance(r["grid"], list) else r["grid"])
+        if r["coupling"] == "one-way" and c is not None and r["converged"]:
+            r.update(hc_err=r["hc_nm"] / c["hc_nm"] - 1.0, hmin_err=r["hmin_nm"] / c["hmin_nm"] - 1.0,
+                     cavity_err_a=r["cavity_over_a"] - c["cavity_over_a"],
+                     half_gas_err_a=r["half_gas_over_a"] - c["half_gas_over_a"])
     return rows
 
 
-TWOPHASE_COLUMNS = [("grid", "grid", "d"), ("cavity_over_a", "sub-ambient l/a", ".3f"),
+TWOPHASE_COLUMNS = [("grid", "grid", "d"), ("coupling", "coupling", ""),
+                    ("hc_nm", "hc [nm]", ".3f"), ("hmin_nm", "hmin [nm]", ".3f"),
+                    ("cavity_over_a", "sub-ambient l/a", ".3f"),
                     ("reaches_outlet", "to outlet", ""), ("half_gas_over_a", "half-gas l/a", ".3f"),
-                    ("converged", "converged", ""), ("wall_s", "wall [s]", ".0f"),
-                    ("cpu_s", "CPU [s]", ".0f"), ("subambient_s", "sub-ambient [s]", ".0f"),
+                    ("film_error", "film err/hc", ".1e"), ("load_error", "load err", ".1e"),
+                    ("outer", "outer", "d"), ("converged", "converged", ""),
+                    ("wall_s", "wall [s]", ".0f"), ("cpu_s", "CPU [s]", ".0f"),
+                    ("subambient_s", "sub-ambient [s]", ".0f"),
                     ("newton", "Newton per grid", ""), ("factorisations", "LUs", "d"),
                     ("peak_GiB", "peak [GiB]", ".2f"), ("load", "load", ".1f")]
+#: the one-way coupling's error against the coupled solution on the same grid
+ONE_WAY_ERROR_COLUMNS = [("grid", "grid", "d"), ("hc_err", "hc one-way/coupled - 1", "+.2%"),
+                         ("hmin_err", "hmin one-way/coupled - 1", "+.2%"),
+                         ("cavity_err_a", "sub-ambient diff [a]", "+.3f"),
+                         ("half_gas_err_a", "half-gas diff [a]", "+.3f")]
+
+
+def print_twophase(rows: list[dict], title: str) -> None:
+    """The two-phase table and the one-way's error against the coupled."""
+    print_table(rows, TWOPHASE_COLUMNS, title)
+    errors = [r for r in rows if "hc_err" in r]
+    if errors:
+        print_table(errors, ONE_WAY_ERROR_COLUMNS, title + ": one-way against coupled")
 
 
 def stability(M: float, L: float, grid: int | None, workers: int | None = None) -> dict:
@@ -175,8 +216,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.twophase_only:
         out = {"twophase_grids": twophase((129, 257, 513) if q else (257, 513, 1025),
                                           args.workers)}
-        print_table(out["twophase_grids"], TWOPHASE_COLUMNS,
-                    "4. two-phase on three grids, 20 mm/s, 25 C, 20 N (thesis model: 0.9 a)")
+        print_twophase(out["twophase_grids"],
+                       "4. two-phase on three grids, 20 mm/s, 25 C, 20 N (thesis model: 0.9 a)")
         write_out(args.out, out)
         return 0
     out: dict = {"dry": [dry(n) for n in ((129,) if q else (257, 513))]}
@@ -198,13 +239,12 @@ def main(argv: list[str] | None = None) -> int:
             ("hc_over_nvm", "hc / NVM", ".3f"), ("hmin_nm", "hmin [nm]", ".2f"),
             ("converged", "converged", "")], "3. reference conditions (HVI60, 20 N, 40 C)")
         out["twophase"] = twophase((257,), args.workers)
-        print_table(out["twophase"], TWOPHASE_COLUMNS,
-                    "4. two-phase, 20 mm/s, 25 C, 20 N (thesis model: 0.9 a)")
+        print_twophase(out["twophase"], "4. two-phase, 20 mm/s, 25 C, 20 N (thesis model: 0.9 a)")
     if args.twophase:
         out["twophase_grids"] = twophase((129, 257, 513) if q else (257, 513, 1025),
                                          args.workers)
-        print_table(out["twophase_grids"], TWOPHASE_COLUMNS,
-                    "4. two-phase on three grids, 20 mm/s, 25 C, 20 N (thesis model: 0.9 a)")
+        print_twophase(out["twophase_grids"],
+                       "4. two-phase on three grids, 20 mm/s, 25 C, 20 N (thesis model: 0.9 a)")
     if args.stability:
         grid = None if args.stability_grid == "default" else int(args.stability_grid)
         rows = [stability(M, L, grid, args.workers) for L in STABILITY_L for M in STABILITY_M]

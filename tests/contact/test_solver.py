@@ -272,9 +272,9 @@ def test_twophase_cavitation(speed):
 
 def test_twophase_cavitation_converges():
     """The two-phase option as solved (the contact by multigrid with p >= 0, then the
-    sub-ambient field by Newton with the film held) converges, load balanced, with the
-    Newton's quadratic end (a handful of iterations from its flow-continuity start). The
-    two-phase density inside the multigrid cycles still stalls (residual ~3e-2)."""
+    sub-ambient field by Newton with the film held, coupled back by an outer iteration)
+    converges, load balanced, the Newton in a handful of iterations. The two-phase density
+    inside the multigrid cycles still stalls (residual ~3e-2)."""
     r = solve(make_spec(load=20, speed=1.0, temperature=40, grid=65, cavitation="twophase",
                         max_cycles=40))
     assert r.converged

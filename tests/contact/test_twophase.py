@@ -15,8 +15,10 @@ from ehlfoam.contact.twophase import _hierarchy, solve_subambient
 
 @pytest.fixture(scope="module")
 def direct():
-    """257 x 129 at 1 m/s: at most COARSEST_ROWS rows, so solved directly (flow start)."""
-    return solve(make_spec(load=20, speed=1.0, temperature=40, grid=129, cavitation="twophase"))
+    """257 x 129 at 1 m/s, one-way: at most COARSEST_ROWS rows, so solved directly (flow
+    start)."""
+    return solve(make_spec(load=20, speed=1.0, temperature=40, grid=129, cavitation="twophase",
+                           twophase_coupling="one-way"))
 
 
 def _problem(r) -> Problem:

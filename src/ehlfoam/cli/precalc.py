@@ -32,6 +32,8 @@ _OPTIONS = {
     "--viscosity": ("viscosity", str, "roelands (default) or barus"),
     "--density": ("density", str, "dowson-higginson (default) or incompressible"),
     "--cavitation": ("cavitation", str, "complementarity (default, p >= 0) or twophase"),
+    "--twophase-coupling": ("twophase_coupling", str, "twophase only: coupled (default, the "
+                            "sub-ambient pressures' deformation and load included) or one-way"),
     "--inlet-layer": ("inlet_layer", float, "starved inlet: oil layer carried in, both "
                       "surfaces together [m] (default: fully flooded)"),
     "--inlet-meniscus": ("inlet_meniscus", float, "starved inlet: meniscus distance upstream "

@@ -14,6 +14,7 @@ from ehlfoam.contact.formulas import Contact, moes_to_hertz_film, nijenbanning_m
 from ehlfoam.contact.inlet import meniscus_x_on_centreline
 from ehlfoam.contact.multigrid import Domain, MGResult, MultigridSolver, Problem, SolverOptions
 from ehlfoam.contact.spec import P_AMBIENT_PA, PrecalcSpec
+from ehlfoam.contact.coupled import Coupling, couple, coupling_errors
 from ehlfoam.contact.twophase import SubAmbientResult, solve_subambient, subambient_deformation
 
 #: When a direct (FMG) start fails, the solve starts again from a solution at a Moes M of
@@ -95,6 +96,9 @@ class PrecalcResult:
     wall_s: float
     continuation: list
     subambient: SubAmbientResult | None = None
+    #: the two-phase option's coupling: its outer iteration and how well the coupled
+    #: equations hold (:class:`~ehlfoam.contact.coupled.Coupling`)
+    coupling: Coupling | None = None
     #: the same contact fully flooded, on the same grid (starved inlet only)
     flooded: "PrecalcResult | None" = None
 
@@ -179,6 +183,14 @@ class PrecalcResult:
             # where more than half the mixture's volume is gas (rho < rho0 / 2)
             out["cavity_half_density_length_over_a"] = self.cavity_length_over_a(
                 -0.5 * self.spec.twophase_p_scale)
+            if self.coupling is not None:
+                cp = self.coupling
+                out["twophase_coupling"] = cp.mode
+                # max |H - (H0 + rigid + W(total P))| over hc, and the total P's load error
+                out["coupling_film_error_over_hc"] = cp.film_error
+                out["coupling_load_error"] = cp.load_error
+                out["coupling_outer_iterations"] = len(cp.outer)
+                out["coupling_outer"] = cp.outer
             if self.subambient is not None:
                 out["subambient_newton_iterations"] = self.subambient.iterations
                 # the film change over the contact the one-way coupling leaves out, at most, over hc
@@ -290,11 +302,25 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
                 break
         if _worse(result, direct):
             result, ramp = direct, []  # the ramp did not help: keep the direct attempt
-    subambient = None
+    subambient = coupling = None
     if twophase and np.all(np.isfinite(result.P)):
-        subambient = solve_subambient(result.P, result.H, dom.h,
-                                      replace(prob, p_floor=p_floor, laws=spec.laws()))
+        sub_prob = replace(prob, p_floor=p_floor, laws=spec.laws())
+        if spec.twophase_coupling == "coupled":
+            result, subambient, outer, coupled_ok = couple(solver, result, sub_prob, dom.h)
+        else:
+            subambient = solve_subambient(result.P, result.H, dom.h, sub_prob)
+            outer, coupled_ok = [], True
         result.P = subambient.P
+        j, i = int(np.argmin(np.abs(result.y))), int(np.argmin(np.abs(result.x)))
+        film_err, load_err = coupling_errors(result.P, result.H, result.H0, result.x, result.y,
+                                             float(result.H[j, i]))
+        coupling = Coupling(spec.twophase_coupling, film_err, load_err, outer, coupled_ok)
+        if not coupled_ok and result.converged and subambient.converged:
+            result.converged = False
+            result.failure = (f"two-phase coupling not converged in {len(outer)} outer "
+                              f"iterations (film error {outer[-1]['film_error_over_hc']:.3g} "
+                              f"of hc, tolerance {coupling.tol:g})" if outer else
+                              "two-phase coupling not converged")
         subambient.deformation_max = subambient_deformation(result.P, dom.h, result.x,
                                                             result.y)
         if not subambient.converged:
@@ -303,4 +329,5 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
                               f"iterations (residual {subambient.residual:.3g})")
     return PrecalcResult(spec=spec, contact=c, domain=dom, mg=result,
                          wall_s=time.perf_counter() - t0, continuation=ramp,
-                         subambient=subambient, flooded=flooded if starved else None)
+                         subambient=subambient, coupling=coupling,
+                         flooded=flooded if starved else None)

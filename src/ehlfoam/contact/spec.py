@@ -78,6 +78,13 @@ class PrecalcSpec(BaseModel):
                     "p / p_s) for gauge p < 0; the default, the ambient pressure, makes the "
                     "density proportional to the absolute pressure.",
         json_schema_extra={"unit": "Pa"})
+    twophase_coupling: Literal["coupled", "one-way"] = Field(
+        "coupled",
+        description='The two-phase option\'s coupling of the sub-ambient pressures to the '
+                    'contact: "coupled": their elastic deformation in the film and their load '
+                    'in the load balance, solved together with the contact by an outer '
+                    'iteration; "one-way": solved with the contact\'s film held (they are '
+                    'left out of both; faster). Used only with cavitation = "twophase".')
     inlet_layer: float | None = Field(
         None, gt=0.0, le=1e-3,
         description="Starved inlet: the oil carried into the contact, both surfaces together, "

@@ -1,13 +1,15 @@
-"""The sub-ambient (two-phase) pressure field behind the contact, one-way coupled.
+"""The sub-ambient (two-phase) pressure field behind the contact, solved with the film held.
 
 The thesis's two-phase model lets the pressure fall below ambient where the gap diverges,
 with a density that drops strongly there (:class:`~ehlfoam.contact.lubricant.PressureLaws`,
-``twophase_p_scale``). Those pressures are bounded by vacuum, |p| <= p_ambient ~ 2e-4 pH:
-their elastic deformation (~1e-4 of the Hertzian one) cannot move the film. So the contact
-is solved first with p >= 0 on the two-phase domain (zero-gradient outlet); then, with the
-film H and the pressurised zone (P > ``p_fixed``) held, the Reynolds equation with the
-two-phase density is solved for P in the rest of the domain by Newton's method on a sparse
-Jacobian (scipy), with P >= vacuum as an active-set constraint.
+``twophase_p_scale``). Those pressures are bounded by vacuum, |p| <= p_ambient ~ 2e-4 pH, but
+spread over several a^2 behind the contact: their elastic deformation varies by about 1 % of
+the central film over the contact (:func:`subambient_deformation`). Here the contact's
+solution (p >= 0 on the two-phase domain, zero-gradient outlet) is given: with its film H and
+its pressurised zone (P > ``p_fixed``) held, the Reynolds equation with the two-phase density
+is solved for P in the rest of the domain by Newton's method on a sparse Jacobian (scipy),
+with P >= vacuum as an active-set constraint. Alone this is the one-way coupling; the coupled
+option repeats it inside an outer iteration with the contact (:mod:`ehlfoam.contact.coupled`).
 
 Nested iteration: the same problem on grids of every other point (film and p >= 0 field
 injected) down to at most :data:`COARSEST_ROWS` rows; the coarsest is solved from the
@@ -24,6 +26,13 @@ iterations). An earlier step's LU is no good preconditioner: points crossing amb
 change their density slope (the law's kink) by orders of magnitude from step to step. The
 coarsest grid uses scipy's default LU, as the plain Newton solve did; every grid is solved
 to ``tol``, so the result is the fine grid's own discrete solution.
+
+Started from an earlier solution instead (``P_start``: the coupled option's later passes,
+:mod:`ehlfoam.contact.coupled`, where the film has changed by a percent or less), the fine
+grid is solved alone, every step's GMRES preconditioned by the first step's LU (refactored
+only where the unknown points change or GMRES does not converge in a few iterations): the
+same steps, one or two factorisations. (In the nested iteration an earlier step's LU saves
+nothing: 8 of 9 fine steps on 513 x 257 still needed their own.)
 """
 
 from __future__ import annotations
@@ -52,6 +61,9 @@ INTERIOR_FRACTION = 0.9
 KRYLOV_RTOL = 1e-6
 KRYLOV_RESTART = 30
 KRYLOV_RESTARTS = 2
+#: GMRES preconditioned by an earlier step's LU gives up after this many iterations (then the
+#: step's own LU)
+REUSED_LU_ITERATIONS = 10
 
 
 @dataclass
@@ -188,7 +200,8 @@ def _factor(J: sp.csc_matrix):
         return spla.splu(J)
 
 
-def _gmres(J: sp.csr_matrix, b: np.ndarray, lu) -> tuple[np.ndarray | None, int]:
+def _gmres(J: sp.csr_matrix, b: np.ndarray, lu, restart: int = KRYLOV_RESTART,
+           restarts: int = KRYLOV_RESTARTS) -> tuple[np.ndarray | None, int]:
     """GMRES on J x = b preconditioned by ``lu``: (x or None if not converged, iterations)."""
     count = [0]
 
@@ -196,21 +209,28 @@ def _gmres(J: sp.csr_matrix, b: np.ndarray, lu) -> tuple[np.ndarray | None, int]
         count[0] += 1
 
     x, info = spla.gmres(J, b, M=spla.LinearOperator(J.shape, lu.solve), rtol=KRYLOV_RTOL,
-                         restart=KRYLOV_RESTART, maxiter=KRYLOV_RESTARTS, callback=tick,
+                         restart=restart, maxiter=restarts, callback=tick,
                          callback_type="pr_norm")
     return (x if info == 0 else None), count[0]
 
 
 def _newton(P: np.ndarray, P0: np.ndarray, H: np.ndarray, h: float, prob: Problem,
-            free: np.ndarray, tol: float, max_iter: int, refined: bool) -> tuple:
+            free: np.ndarray, tol: float, max_iter: int, refined: bool,
+            keep_lu: float = 0.0) -> tuple:
     """Damped Newton from P on the ``free`` points. ``refined``: a start interpolated from a
     coarser solution (steps held inside the vacuum bound; each step's system by GMRES
     preconditioned by its own LU without pivoting, :func:`_factor`); else each step's own
-    LU (scipy's default, partial pivoting) and a plain projection onto P >= vacuum. Returns (P, converged, iterations,
-    residual, factorisations, GMRES iterations)."""
+    LU (scipy's default, partial pivoting) and a plain projection onto P >= vacuum.
+    ``keep_lu`` (refined only): while the residual is below it, GMRES preconditioned by the
+    last LU as long as the unknown points are the same and it converges in
+    :data:`REUSED_LU_ITERATIONS` (a start close to the solution, ``inf``: the coupled
+    option's later passes, one or two LUs instead of four to six); a new LU where not (0:
+    always; in the nested iteration a reused LU measured no faster). Returns (P, converged,
+    iterations, residual, factorisations, GMRES iterations)."""
     r = np.zeros_like(P)
     wedge = np.zeros_like(P)
     f0 = np.zeros_like(P)
+    lu, lu_of = None, None
 
     def evaluate(P):
         rho, drho, eps = _coefficients(P, H, prob)
@@ -239,12 +259,20 @@ def _newton(P: np.ndarray, P0: np.ndarray, H: np.ndarray, h: float, prob: Proble
         J = _jacobian(P, H, rho, drho, eps, h, unknown, _eps_slope(P, H, drho, prob))
         b = r[unknown]
         x = None
-        if refined:
+        if refined and res < keep_lu and lu is not None and np.array_equal(lu_of, unknown):
+            # an earlier step's LU: refactored if GMRES does not converge in a few iterations
+            x, n = _gmres(J, b, lu, REUSED_LU_ITERATIONS, 1)
+            n_krylov += n
+        if refined and x is None:
+            lu = None  # released before the next factorisation (one LU in memory at a time)
             try:
-                x, n = _gmres(J, b, _factor(J.tocsc()))
+                lu, lu_of = _factor(J.tocsc()), unknown.copy()
+                x, n = _gmres(J, b, lu)
             except RuntimeError:  # singular: the direct solve below says so
-                x, n = None, 0
+                lu, x, n = None, None, 0
             n_lu, n_krylov = n_lu + 1, n_krylov + n
+            if not keep_lu:
+                lu = None
         if x is None:  # a direct solve: scipy's LU with partial pivoting
             n_lu += 1
             try:
@@ -318,7 +346,9 @@ def solve_subambient(P0: np.ndarray, H: np.ndarray, h: float, prob: Problem,
         if prob.neumann_outlet:
             start[:, -1] = start[:, -2]
         P, ok, its, res, n_lu, n_krylov = _newton(start, p0, hh, s, prob, _free(p0, p_fixed),
-                                                  tol, max_iter, refined)
+                                                  tol, max_iter, refined,
+                                                  keep_lu=np.inf if P_start is not None
+                                                  else 0.0)
         levels.append(dict(shape=list(p0.shape), iterations=its, factorisations=n_lu,
                            krylov_iterations=n_krylov, residual=res, converged=ok,
                            wall_s=time.perf_counter() - t0))

@@ -27,8 +27,11 @@ class PrecalcFailed(RuntimeError):
 
 def spec_key(spec: PrecalcSpec) -> str:
     """A stable hash of everything that changes the solution (the starved-inlet keys only
-    when set, so a flooded spec keeps the key it had before they existed)."""
+    when set and the two-phase coupling only with the two-phase option, so a flooded
+    complementarity spec keeps the key it had before they existed)."""
     unset = {k for k in ("inlet_layer", "inlet_meniscus") if getattr(spec, k) is None}
+    if spec.cavitation != "twophase":
+        unset.add("twophase_coupling")
     return hashlib.sha256(spec.model_dump_json(exclude=unset).encode()).hexdigest()[:16]
 
 
