@@ -13,9 +13,9 @@ film and their (negative) load from the load balance. Coupled, a block Gauss-Sei
    finest grid only, no nested iteration after the first pass);
 
 until the film of the last Newton solve is H0 + rigid shape + the deformation of the total
-pressure to ``tol`` times the central film anywhere on the domain. The held field is the sub-ambient solve's change of the
-pressure: its solved values minus the contact's on the points it solves for (the contact's
-P there is 0 or below ``p_fixed``). At the converged state the film of the last Newton
+pressure to ``tol`` times the central film anywhere on the domain. The held field is the
+sub-ambient solve's change of the pressure: its solved values minus the contact's on the
+points it solves for (the contact's P there is 0 or below ``p_fixed``). At the converged state the film of the last Newton
 solve is rigid shape + H0 + deformation of the total pressure to the tolerance, and the
 total pressure carries the load to about the multigrid's load tolerance (the held field's
 last change is ~1e-6 of the load) (:func:`coupling_errors`).
@@ -35,7 +35,8 @@ from ehlfoam.contact.twophase import SubAmbientResult, solve_subambient
 
 __all__ = ["COUPLING_TOL", "MAX_OUTER", "Coupling", "couple", "coupling_errors"]
 
-#: The outer iteration stops once the film changes by less than this times hc between passes.
+#: The outer iteration stops once the film error (:func:`coupling_errors`) is below this
+#: times hc anywhere on the domain.
 COUPLING_TOL = 1e-3
 #: Outer iterations at most.
 MAX_OUTER = 10
