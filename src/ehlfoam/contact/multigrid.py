@@ -10,8 +10,8 @@ zero-gradient outlet) and the film constant H0. Equations on every level:
 On the finest level f = 0, tauW = 0 and target = 2 pi / 3 (unless a load is held there,
 :meth:`MultigridSolver.hold`: tauW is its deformation, the target less its load). The coarse
 levels carry the FAS right-hand sides (restricted residual plus coarse operator of the
-injected pressure), the FAS correction of the film (fine deformation minus coarse deformation of the injected
-pressure) and of the load. H0 is relaxed against the load on the coarsest level, whose
+injected pressure), the FAS correction of the film (fine deformation minus coarse
+deformation of the injected pressure) and of the load. H0 is relaxed against the load on the coarsest level, whose
 problem is solved (rounds of sweeps and H0 steps). Full multigrid (FMG) start from a
 Hertzian pressure on the coarsest level, each finer level cycled to its own discretisation
 error; the finest level until its film has settled (see :class:`SolverOptions`). The levels,
