@@ -15,10 +15,11 @@ film and their (negative) load from the load balance. Coupled, a block Gauss-Sei
 until the film of the last Newton solve is H0 + rigid shape + the deformation of the total
 pressure to ``tol`` times the central film anywhere on the domain. The held field is the
 sub-ambient solve's change of the pressure: its solved values minus the contact's on the
-points it solves for (the contact's P there is 0 or below ``p_fixed``). At the converged state the film of the last Newton
-solve is rigid shape + H0 + deformation of the total pressure to the tolerance, and the
-total pressure carries the load to about the multigrid's load tolerance (the held field's
-last change is ~1e-6 of the load) (:func:`coupling_errors`).
+points it solves for (the contact's P there is 0 or below ``p_fixed``). At the converged
+state the film of the last Newton solve is rigid shape + H0 + deformation of the total
+pressure to the tolerance, and the total pressure carries the load to about the multigrid's
+load tolerance (the held field's last change is ~1e-6 of the load)
+(:func:`coupling_errors`).
 """
 
 from __future__ import annotations
@@ -102,7 +103,7 @@ def couple(solver: MultigridSolver, first: MGResult, prob: Problem, h: float,
     mg = first
     t0 = time.perf_counter()
     sub = solve_subambient(mg.P, mg.H, h, prob, p_fixed=p_fixed)
-    j, i = int(np.argmin(np.abs(mg.y))), int(np.argmin(np.abs(mg.x)))
+    centre = mg.centre_index()
     deform = solver.levels[-1].deform
     outer: list[dict] = []
     converged = False
@@ -114,11 +115,11 @@ def couple(solver: MultigridSolver, first: MGResult, prob: Problem, h: float,
             t1 = time.perf_counter()
             nxt = solver.solve(mg.H0, P_init=mg.P, fmg_hc=first.fmg_hc)
             sub = solve_subambient(nxt.P, nxt.H, h, prob, p_fixed=p_fixed, P_start=sub.P)
-            hc = float(nxt.H[j, i])
+            hc = float(nxt.H[centre])
             film_err, load_err = coupling_errors(sub.P, nxt.H, nxt.H0, nxt.x, nxt.y, hc, deform)
             ok = bool(nxt.converged and sub.converged)
             outer.append(dict(iteration=k, film_error_over_hc=film_err, load_error=load_err,
-                              hc_change_over_hc=(hc - float(mg.H[j, i])) / hc,
+                              hc_change_over_hc=(hc - float(mg.H[centre])) / hc,
                               hmin_change_over_hc=float(nxt.H.min() - mg.H.min()) / hc,
                               cycles=nxt.cycles, newton_iterations=sub.iterations,
                               factorisations=sum(lv["factorisations"] for lv in sub.levels),

@@ -11,12 +11,13 @@ On the finest level f = 0, tauW = 0 and target = 2 pi / 3 (unless a load is held
 :meth:`MultigridSolver.hold`: tauW is its deformation, the target less its load). The coarse
 levels carry the FAS right-hand sides (restricted residual plus coarse operator of the
 injected pressure), the FAS correction of the film (fine deformation minus coarse
-deformation of the injected pressure) and of the load. H0 is relaxed against the load on the coarsest level, whose
-problem is solved (rounds of sweeps and H0 steps). Full multigrid (FMG) start from a
-Hertzian pressure on the coarsest level, each finer level cycled to its own discretisation
-error; the finest level until its film has settled (see :class:`SolverOptions`). The levels,
-the options and the problem: :mod:`ehlfoam.contact.levels`; transfers:
-:mod:`ehlfoam.contact.transfer`; a starved inlet's film content: :mod:`ehlfoam.contact.inlet`.
+deformation of the injected pressure) and of the load. H0 is relaxed against the load on the
+coarsest level, whose problem is solved (rounds of sweeps and H0 steps). Full multigrid
+(FMG) start from a Hertzian pressure on the coarsest level, each finer level cycled to its
+own discretisation error; the finest level until its film has settled (see
+:class:`SolverOptions`). The levels, the options and the problem:
+:mod:`ehlfoam.contact.levels`; transfers: :mod:`ehlfoam.contact.transfer`; a starved inlet's
+film content: :mod:`ehlfoam.contact.inlet`.
 """
 
 from __future__ import annotations
@@ -63,6 +64,10 @@ class MGResult:
     work_units: float = 0.0
     #: film content of the finest level (starved inlet; 1 elsewhere), None if not kept
     theta: np.ndarray | None = None
+
+    def centre_index(self) -> tuple[int, int]:
+        """(row, column) of the grid point nearest the contact's centre."""
+        return int(np.argmin(np.abs(self.y))), int(np.argmin(np.abs(self.x)))
 
 
 class MultigridSolver:

@@ -107,7 +107,7 @@ class PrecalcResult:
         return self.mg.converged
 
     def centre_index(self) -> tuple[int, int]:
-        return int(np.argmin(np.abs(self.mg.y))), int(np.argmin(np.abs(self.mg.x)))
+        return self.mg.centre_index()
 
     @property
     def H_central(self) -> float:
@@ -311,9 +311,12 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
             subambient = solve_subambient(result.P, result.H, dom.h, sub_prob)
             outer, coupled_ok = [], True
         result.P = subambient.P
-        j, i = int(np.argmin(np.abs(result.y))), int(np.argmin(np.abs(result.x)))
-        film_err, load_err = coupling_errors(result.P, result.H, result.H0, result.x, result.y,
-                                             float(result.H[j, i]))
+        if outer:  # the last pass measured the solution returned
+            film_err, load_err = outer[-1]["film_error_over_hc"], outer[-1]["load_error"]
+        else:
+            film_err, load_err = coupling_errors(result.P, result.H, result.H0, result.x,
+                                                 result.y, float(result.H[result.centre_index()]),
+                                                 solver.levels[-1].deform)
         coupling = Coupling(spec.twophase_coupling, film_err, load_err, outer, coupled_ok)
         if not coupled_ok and result.converged and subambient.converged:
             result.converged = False
