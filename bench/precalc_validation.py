@@ -154,7 +154,8 @@ def twophase(grids: tuple[int, ...], workers: int | None,
     for r in rows:
         c = coupled.get(r["grid"][1] if isinstance(r["grid"], list) else r["grid"])
         if r["coupling"] == "one-way" and c is not None and r["converged"]:
-            r.update(hc_err=r["hc_nm"] / c["hc_nm"] - 1.0, hmin_err=r["hmin_nm"] / c["hmin_nm"] - 1.0,
+            r.update(hc_err=r["hc_nm"] / c["hc_nm"] - 1.0,
+                     hmin_err=r["hmin_nm"] / c["hmin_nm"] - 1.0,
                      cavity_err_a=r["cavity_over_a"] - c["cavity_over_a"],
                      half_gas_err_a=r["half_gas_over_a"] - c["half_gas_over_a"])
     return rows

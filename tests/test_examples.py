@@ -1,9 +1,10 @@
-"""The example specs users start from: every one is valid (tests/batch/test_spec.py), every case
-spec builds with a small precalc grid, and the short ones run, cut short: a coarse mesh and a
-few hundredths of a transit, a stop of milliseconds (the run's own settings otherwise). The
-cases of tens of thousands of cells (the film-resolving boxes, the levels that follow the
-meniscus) are built only: a run of theirs takes minutes even cut short. nominal_resolved.toml's mesh follows a start state's
-meniscus, so it is built from a thin-film state the test makes first."""
+"""The example specs users start from: every one is valid (tests/batch/test_spec.py), every
+case spec builds with a small precalc grid, and the short ones run, cut short: a coarse mesh
+and a few hundredths of a transit, a stop of milliseconds (the run's own settings
+otherwise). The cases of tens of thousands of cells (the film-resolving boxes, the levels
+that follow the meniscus) are built only: a run of theirs takes minutes even cut short.
+nominal_resolved.toml's mesh follows a start state's meniscus, so it is built from a
+thin-film state the test makes first."""
 
 from __future__ import annotations
 

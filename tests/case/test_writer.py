@@ -1019,8 +1019,9 @@ def test_static_meniscus_moves_less_than_1_percent_of_u_with_balanced_schemes(tm
     """Where the issue's 1 % holds at the default compression (cAlpha 1), here on the coarse
     level: the balanced interface schemes (at 3 a also three sub-cycles and half the
     capillary limit, the quiet configuration: bench/static_meniscus.py). What moves a
-    meniscus in a thin gap is the gap-averaged oil velocity; at every write of the second half of 60 ms its largest value
-    stays below 1 % of u, the meniscus stays where it started and the oil volume holds."""
+    meniscus in a thin gap is the gap-averaged oil velocity; at every write of the second
+    half of 60 ms its largest value stays below 1 % of u, the meniscus stays where it
+    started and the oil volume holds."""
     speed = 0.008
     puddle, run_options = QUIET_STATICS[config]
     spec = make_case_spec({
