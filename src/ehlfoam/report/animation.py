@@ -47,10 +47,18 @@ def _label(image: np.ndarray, text: str):
     return im.quantize(colors=48, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
 
 
-def _frame(folder: Path, t: float, geom, structure: case_fields.Structure):
+def written_pattern(folder: Path, geom, structure: case_fields.Structure
+                    ) -> tuple[flow.Raster, dict]:
+    """The top view's raster of one written time of a 3D case (its mid-gap oil fraction) and
+    the flow pattern the metrics read from it."""
     mid = case_fields.mid_gap_alpha(folder, structure, geom)
     r = case_fields.column_raster(mid, structure, geom)
-    state = flow.flow_pattern_from_raster(r)["state"]
+    return r, flow.flow_pattern_from_raster(r)
+
+
+def _frame(folder: Path, t: float, geom, structure: case_fields.Structure):
+    r, pattern = written_pattern(folder, geom, structure)
+    state = pattern["state"]
     text = f"t = {t * 1e3:.1f} ms  ({t / geom.transit_time:.2f} transits)  state {state}"
     return _label(colour_frame(r), text)
 

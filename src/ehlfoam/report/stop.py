@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ehlfoam.case.geometry import CaseGeometry
-from ehlfoam.report.animation import _label, colour_frame
+from ehlfoam.report.animation import _label, colour_frame, written_pattern
 from ehlfoam.report.thin_film import ThinFilmFields
 from ehlfoam.run.thin_film import FRAMES_DIR
 from ehlfoam.spec.stop import Stop, wall_speed_at
@@ -49,14 +49,11 @@ def _thin_film_frames(case: Path, geom: CaseGeometry):
 def _written_frames(case: Path, geom: CaseGeometry):
     """The same of each time a 3D run wrote: the enclosed bubbles the metrics count, the
     raster's pixels of enclosed gas not counted (None)."""
-    from ehlfoam.metrics import pattern as flow
     from ehlfoam.run import fields as case_fields
 
     structure = case_fields.Structure.load(case)
     for t, folder in case_fields.time_folders(case):
-        mid = case_fields.mid_gap_alpha(folder, structure, geom)
-        raster = case_fields.column_raster(mid, structure, geom)
-        pattern = flow.flow_pattern_from_raster(raster)
+        raster, pattern = written_pattern(folder, geom, structure)
         yield t, raster, pattern, int(pattern.get("enclosed_bubbles") or 0), None
 
 
