@@ -26,7 +26,7 @@ import math
 import os
 import time
 
-from common import add_output_options, print_table, ratios, solve_in_subprocess, write_out
+from common import add_output_options, print_table, solve_in_subprocess, write_out
 
 NOMINAL = dict(load=20.0, temperature=40.0)
 
@@ -41,11 +41,16 @@ def row_of(n: int, s: dict) -> dict:
                 load_average=s.get("load_average", (None,))[0])
 
 
+def doubling(grids) -> list[int]:
+    """The grids of 2**k + 1 points among ``grids``, ascending."""
+    return sorted(n for n in set(grids) if (n - 1) & (n - 2) == 0)
+
+
 def richardson(rows: list[dict]) -> dict:
     """The observed order p of hc over the three finest grids (a doubling apart), the
-    extrapolated hc [nm], and each row's hc error against it."""
+    extrapolated hc [nm], and each row's hc error against it (every grid's, 769 included)."""
     by_n = {r["N"]: r["hc_nm"] for r in rows}
-    h = [by_n[n] for n in sorted(by_n)[-3:]]
+    h = [by_n[n] for n in doubling(by_n)[-3:]]
     d1, d2 = h[1] - h[0], h[2] - h[1]
     p = math.log2(abs(d1 / d2)) if d1 and d2 else float("nan")
     extrap = h[2] + d2 / (2**p - 1) if math.isfinite(p) and p else float("nan")
@@ -56,11 +61,15 @@ def richardson(rows: list[dict]) -> dict:
 
 def per_threads(rows: list[dict]) -> None:
     """The cost ratios per doubling of N (``cost_ratio`` of wall time, ``cpu_ratio``), each
-    against the previous grid's row on the same thread count."""
+    against the row of half the cells a side on the same thread count (none for a grid
+    without one, e.g. 769 among 2**k + 1 grids)."""
     for threads in dict.fromkeys(r["threads"] for r in rows):
-        same = [r for r in rows if r["threads"] == threads]
-        ratios(same, "wall_s", "cost_ratio")
-        ratios(same, "cpu_s", "cpu_ratio")
+        same = {r["N"]: r for r in rows if r["threads"] == threads}
+        for n, row in same.items():
+            half = same.get((n - 1) // 2 + 1)
+            for key, name in (("wall_s", "cost_ratio"), ("cpu_s", "cpu_ratio")):
+                ok = half is not None and half.get(key) and row.get(key) is not None
+                row[name] = row[key] / half[key] if ok else None
 
 
 #: neighbours of the nominal point that ``--reuse`` starts it from
@@ -102,7 +111,8 @@ def reuse(case: dict) -> dict:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--grids", nargs="+", type=int, default=[129, 257, 513, 1025, 2049],
-                    help="points a side, coarse to fine, a doubling apart")
+                    help="points a side, coarse to fine, the three finest a doubling apart "
+                         "(others, e.g. 769, between them)")
     ap.add_argument("--speed", type=float, default=0.01, help="rolling speed [m/s]")
     ap.add_argument("--workers", nargs="+", type=int, default=[None],
                     help="thread counts of each solve (default: the solver's own choice)")
@@ -121,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
             for n in args.grids for w in args.workers]
     per_threads(rows)
     out: dict = {"case": case, "rows": rows}
-    if len(args.grids) >= 3:
+    if len(doubling(args.grids)) >= 3:
         out.update(richardson(rows))
     print_table(rows, [("N", "N", "d"), ("wall_s", "wall [s]", ".1f"),
                        ("threads", "threads", "d"), ("cpu_s", "CPU [s]", ".1f"),
@@ -132,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
                        ("ramp", "ramp", ""), ("load_average", "load avg", ".2f")])
     if "observed_order" in out:
         within = [r["N"] for r in rows if (r["hc_error"] or 1.0) <= 0.02]
-        ns = sorted({r["N"] for r in rows})
+        ns = doubling(r["N"] for r in rows)
         print(f"observed order {out['observed_order']:.2f} (grids {ns[-3]}, {ns[-2]}, "
               f"{ns[-1]}); Richardson hc {out['hc_extrapolated_nm']:.4f} nm; coarsest grid "
               f"within 2 %: {min(within) if within else None}")

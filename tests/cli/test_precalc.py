@@ -190,6 +190,7 @@ BAD = [
     (["--temperature", "500"], "temperature", "500", ["HVI60", "25 to 60 C"]),
     (["--grid", "100"], "grid", "100", ["2**k + 1", "65", "8193"]),
     (["--grid", "33"], "grid", "33", ["2**k + 1", "65", "8193"]),
+    (["--grid", "641"], "grid", "641", ["3*2**k + 1", "769"]),
     (["--load", "abc"], "load", "abc", ["not a number", "0 < load <= 100000 N"]),
     (["--viscosity", "sutherland"], "viscosity", "sutherland", ["roelands", "barus"]),
     (["--max-cycles", "0"], "max_cycles", "0", ["greater than or equal to 1"]),

@@ -210,9 +210,9 @@ def test_film_criterion_stops_at_the_converged_film(kw):
 
 
 def test_fmg_hc_approaches_the_richardson_value():
-    """hc on 129 and 257 points a side against the Richardson value of 65-129-257 (second
-    order): the finer grid is the closer, within the 2 % that the default grids promise for
-    M < 300."""
+    """hc on 129, 257 and 513 points a side against the Richardson value of 129-257-513
+    (second order): the finer grid is the closer, within the 2 % that the default grids
+    promise for M < 300; a 3 * 2**k + 1 grid (385) falls between its neighbours."""
     kw = dict(load=20, speed=0.5, temperature=40)
     hc = [solve(make_spec(**kw, grid=n)).summary()["hc_m"] for n in (129, 257, 513)]
     rich = hc[2] + (hc[2] - hc[1]) / 3.0
@@ -221,6 +221,9 @@ def test_fmg_hc_approaches_the_richardson_value():
     assert errors[2] < 0.02
     order = math.log2(abs(hc[1] - hc[0]) / abs(hc[2] - hc[1]))
     assert 1.5 < order < 2.5
+    between = solve(make_spec(**kw, grid=385))
+    assert between.converged and between.mg.x.size == 385
+    assert errors[1] > abs(between.summary()["hc_m"] / rich - 1.0) > errors[2]
 
 
 def test_work_per_grid_doubling_does_not_grow():

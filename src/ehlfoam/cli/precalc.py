@@ -38,7 +38,7 @@ _OPTIONS = {
                       "surfaces together [m] (default: fully flooded)"),
     "--inlet-meniscus": ("inlet_meniscus", float, "starved inlet: meniscus distance upstream "
                          "of x = -a [a] (default: fully flooded)"),
-    "--grid": ("grid", int, "grid points per side, 2^k+1 (default: chosen from M)"),
+    "--grid": ("grid", int, "grid points per side, 2^k+1 or 3*2^k+1 (default: chosen from M)"),
     "--max-cycles": ("max_cycles", int, "multigrid cycle limit (default 100)"),
 }
 

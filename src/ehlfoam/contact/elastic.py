@@ -63,7 +63,8 @@ class Deformation:
     ``op(P)`` returns W on the same grid; the kernel spectrum is computed once. A pressure
     that vanishes on the first row and the first column (the solver's Dirichlet inlet and
     side boundary) needs a circulant of only 2(n - 1) points a side (offsets from -(n - 1)
-    to n - 2 occur), a power of two on the solver's 2^k + 1 grids; any other pressure uses
+    to n - 2 occur), a power of two (or three times one: 1536 on 769 points) on the
+    solver's grids, sizes the FFT takes fast; any other pressure uses
     2n. The zero padding is skipped axis by axis (half the rows transformed), and the
     kernel's spectrum is real (the kernel is even). ``workers``: threads of scipy.fft.
     """
