@@ -1,16 +1,18 @@
 """Cost and accuracy of the EHL precalc against grid size.
 
-    python bench/precalc_cost.py [--grids 129 257 513 1025 2049] [--speed 0.01]
-        [--workers 1 2] [--memory N] [--reuse] [--out FILE.json]
+    python bench/precalc_cost.py [--grids 129 257 513 1025 2049] [--speed 0.01] [--load 20]
+        [--temperature 40] [--workers 1 2] [--memory N] [--reuse] [--out FILE.json]
     python bench/precalc_cost.py --quick
 
-The nominal contact (20 N, 40 C, HVI60, the default laws) at --speed [m/s], solved on each
-grid of N points a side in a fresh process (numba compiled beforehand) on each thread count
-of --workers (the solver's one thread setting; default: its own choice): wall and CPU time,
-cycles, peak memory of the process, hc and hmin, convergence, and the machine's load average
-(timings on a shared machine are noisy); with three grids or more, the observed order of hc's
-convergence and its Richardson extrapolation from the three finest, each grid's hc error
-against it, and the cost ratio per doubling of N (wall and CPU, per thread count).
+The nominal contact (20 N, 40 C, HVI60, the default laws; --load [N], --temperature [C]
+change it) at --speed [m/s], solved on each grid of N points a side in a fresh process
+(numba compiled beforehand) on each thread count of --workers (the solver's one thread
+setting; default: its own choice): wall and CPU time, cycles, peak memory of the process, hc
+and hmin, the solve's own estimate of hc's grid error, convergence, and the machine's load
+average (timings on a shared machine are noisy); with three grids or more, the observed
+order of hc's convergence and its Richardson extrapolation from the three finest, each
+grid's hc error against it, and the cost ratio per doubling of N (wall and CPU, per thread
+count).
 ``--memory N`` also runs three cycles on N points a side and reports their peak memory (it is
 reached in the first cycle). ``--reuse`` also times the nominal point on its default grid
 started from a neighbouring solution (another speed, temperature or load;
@@ -37,6 +39,7 @@ def row_of(n: int, s: dict) -> dict:
                 cycles=s.get("cycles"), peak_GiB=s["peak_rss_GiB"],
                 hc_nm=s["hc_m"] * 1e9 if s.get("hc_m") else None,
                 hmin_nm=s["hmin_m"] * 1e9 if s.get("hmin_m") else None,
+                hc_grid_error_estimate=s.get("hc_grid_error"),
                 converged=bool(s["converged"]), ramp=bool(s.get("continuation_M")),
                 load_average=s.get("load_average", (None,))[0])
 
@@ -114,6 +117,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="points a side, coarse to fine, the three finest a doubling apart "
                          "(others, e.g. 769, between them)")
     ap.add_argument("--speed", type=float, default=0.01, help="rolling speed [m/s]")
+    ap.add_argument("--load", type=float, default=NOMINAL["load"], help="load [N]")
+    ap.add_argument("--temperature", type=float, default=NOMINAL["temperature"],
+                    help="temperature [C]")
     ap.add_argument("--workers", nargs="+", type=int, default=[None],
                     help="thread counts of each solve (default: the solver's own choice)")
     ap.add_argument("--memory", type=int, default=None, metavar="N",
@@ -124,7 +130,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.quick:
         args.grids, args.speed = [129, 257], 0.2
-    case = {**NOMINAL, "speed": args.speed}
+    case = dict(load=args.load, temperature=args.temperature, speed=args.speed)
     print(f"EHL precalc, {case['load']:g} N, {case['temperature']:g} C, {args.speed:g} m/s, "
           f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}")
     rows = [row_of(n, solve_in_subprocess({**case, "grid": n}, workers=w))
@@ -138,7 +144,9 @@ def main(argv: list[str] | None = None) -> int:
                        ("cost_ratio", "x per doubling", ".2f"), ("cpu_ratio", "CPU x", ".2f"),
                        ("cycles", "cycles", "d"), ("peak_GiB", "peak [GiB]", ".2f"),
                        ("hc_nm", "hc [nm]", ".4f"), ("hmin_nm", "hmin [nm]", ".4f"),
-                       ("hc_error", "hc error", ".2%"), ("converged", "converged", ""),
+                       ("hc_error", "hc error", ".2%"),
+                       ("hc_grid_error_estimate", "its estimate", ".2%"),
+                       ("converged", "converged", ""),
                        ("ramp", "ramp", ""), ("load_average", "load avg", ".2f")])
     if "observed_order" in out:
         within = [r["N"] for r in rows if (r["hc_error"] or 1.0) <= 0.02]

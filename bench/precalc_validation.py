@@ -24,8 +24,9 @@
 5. With ``--stability``: converged / stagnated / failed over M = 10..3e4 x L = 0..20 on
    ``--stability-grid`` points a side (``default``: the solver's own grid).
 6. With ``--accuracy``: the 18-point table (5 / 20 / 30 N x 25 / 40 / 60 C, each at 10 mm/s
-   and at 2 or 40 mm/s: Moes M 343-34,215) on the default grids, hc beside the solver of
-   main 5ad327e (before the full multigrid of issue 77), cycles, wall and CPU time.
+   and at 2 or 40 mm/s: Moes M 343-34,215) on the grids main 5ad327e (before the full
+   multigrid of issue 77) solved them on, hc beside its, each solve's estimate of its grid
+   error, cycles, wall and CPU time.
 
 Each solve runs in a fresh process, on ``--workers`` threads (default: the solver's own
 choice). ``--quick``: the dry limit and four NVM points at M <= 100 on 129 points a side
@@ -101,20 +102,37 @@ def reference(u: float, laws: dict, workers: int | None = None) -> dict:
 
 
 def accuracy(workers: int | None) -> dict:
-    """The 18 points of :data:`HC_MAIN_5AD327E_NM` on their default grids: hc against main
-    5ad327e's, cycles and cost."""
-    rows = []
+    """The 18 points of :data:`HC_MAIN_5AD327E_NM` on the grids main 5ad327e solved them on
+    (513 points a side below M = 300, 1025 above; the default is 2049 from M = 8000 now):
+    hc against main 5ad327e's, the solve's own grid-error estimate, cycles and cost; where
+    the default grid is another, also that solve (``default_rows``: hc, its change, its
+    estimate and cost)."""
+    from ehlfoam.contact.solver import default_grid
+    from ehlfoam.contact.spec import make_spec
+
+    rows, default_rows = [], []
     for (F, T, u), before in HC_MAIN_5AD327E_NM.items():
-        s = solve_in_subprocess(dict(load=float(F), temperature=float(T), speed=u),
-                                workers=workers)
+        case = dict(load=float(F), temperature=float(T), speed=u)
+        M = make_spec(**case).contact().M
+        grid = 513 if M < 300.0 else 1025
+        s = solve_in_subprocess({**case, "grid": grid}, workers=workers)
         hc = s["hc_m"] * 1e9
         rows.append(dict(load_N=F, temperature_C=T, speed_mm_s=u * 1e3, M=s["M"], L=s["L"],
-                         grid=s["grid"], hc_nm=hc, hc_main_nm=before, diff=hc / before - 1.0,
+                         grid=s["grid"], hc_grid_error=s.get("hc_grid_error"),
+                         hc_nm=hc, hc_main_nm=before, diff=hc / before - 1.0,
                          cycles=s["cycles"], wall_s=s["wall_s"], cpu_s=s["cpu_s"],
                          converged=bool(s["converged"]), ramp=bool(s.get("continuation_M"))))
+        if default_grid(M) != grid:
+            d = solve_in_subprocess(case, workers=workers)
+            default_rows.append(dict(rows[-1], grid=d["grid"], hc_nm=d["hc_m"] * 1e9,
+                                     diff=d["hc_m"] * 1e9 / hc - 1.0,
+                                     hc_grid_error=d.get("hc_grid_error"), cycles=d["cycles"],
+                                     wall_s=d["wall_s"], cpu_s=d["cpu_s"],
+                                     converged=bool(d["converged"])))
     total = dict(wall_s=sum(r["wall_s"] for r in rows), cpu_s=sum(r["cpu_s"] for r in rows))
     return dict(rows=rows, largest_diff=max(abs(r["diff"]) for r in rows), **total,
-                workers=workers)
+                workers=workers, default_rows=default_rows,
+                default_cpu_s=sum(r["cpu_s"] for r in default_rows))
 
 
 def twophase(grids: tuple[int, ...], workers: int | None,
@@ -263,10 +281,20 @@ def main(argv: list[str] | None = None) -> int:
             ("speed_mm_s", "u [mm/s]", "g"), ("M", "M", ".0f"), ("L", "L", ".2f"),
             ("grid", "grid", "d"), ("hc_nm", "hc [nm]", ".4f"),
             ("hc_main_nm", "5ad327e [nm]", ".4f"), ("diff", "diff", "+.2%"),
+            ("hc_grid_error", "grid error (est.)", ".1%"),
             ("cycles", "cycles", "d"), ("wall_s", "wall [s]", ".1f"), ("cpu_s", "CPU [s]", ".1f"),
             ("converged", "converged", "")], "6. accuracy, 18 points against main 5ad327e")
         print(f"largest |hc - 5ad327e| / 5ad327e = {acc['largest_diff']:.2%}; total "
               f"{acc['wall_s']:.0f} s wall, {acc['cpu_s']:.0f} s CPU")
+        if acc["default_rows"]:
+            print_table(acc["default_rows"], [
+                ("load_N", "F [N]", "g"), ("temperature_C", "T [C]", "g"),
+                ("speed_mm_s", "u [mm/s]", "g"), ("M", "M", ".0f"), ("grid", "grid", "d"),
+                ("hc_nm", "hc [nm]", ".4f"), ("diff", "against the row above", "+.2%"),
+                ("hc_grid_error", "grid error (est.)", ".1%"), ("cycles", "cycles", "d"),
+                ("cpu_s", "CPU [s]", ".1f"), ("converged", "converged", "")],
+                "6b. the points whose default grid is finer, on it")
+            print(f"their CPU on the default grid: {acc['default_cpu_s']:.0f} s")
     write_out(args.out, out)
     return 0
 

@@ -130,6 +130,22 @@ def test_png(converged_run):
 
 # --- TOML route ----------------------------------------------------------------------------------
 
+def test_a_coarse_grid_warns_with_its_error_estimate(tmp_path, capsys):
+    """The nominal contact (M 3886) on 257 points a side is some 15 % off its grid-converged
+    hc: the summary's estimate is above the warning's limit and stderr warns, naming --grid;
+    the default grid (0.8 % off) stays below it."""
+    from ehlfoam.contact.solver import GRID_ERROR_WARN
+
+    rc, _, err = run_cli(capsys, "--speed", "0.01", "--grid", "257", "--out", tmp_path / "c")
+    s = strict_json(tmp_path / "c" / "summary.json")
+    assert rc == 0 and GRID_ERROR_WARN < s["hc_grid_error"] < 0.20
+    assert "warning" in err and "--grid" in err and f"{s['hc_grid_error']:.1%}" in err
+    rc, _, err = run_cli(capsys, "--speed", "0.01", "--out", tmp_path / "d")
+    s = strict_json(tmp_path / "d" / "summary.json")
+    assert rc == 0 and s["grid"] == [1025, 1025] and s["hc_grid_error"] < 0.015
+    assert "warning" not in err
+
+
 def test_toml_spec_with_cli_override(tmp_path, capsys):
     spec = tmp_path / "spec.toml"
     spec.write_text("[precalc]\nload = 20.0\nspeed = 0.01\ntemperature = 40.0\ngrid = 129\n")

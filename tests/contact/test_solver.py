@@ -214,11 +214,15 @@ def test_fmg_hc_approaches_the_richardson_value():
     (second order): the finer grid is the closer, within the 2 % that the default grids
     promise for M < 300; a 3 * 2**k + 1 grid (385) falls between its neighbours."""
     kw = dict(load=20, speed=0.5, temperature=40)
-    hc = [solve(make_spec(**kw, grid=n)).summary()["hc_m"] for n in (129, 257, 513)]
+    results = [solve(make_spec(**kw, grid=n)) for n in (129, 257, 513)]
+    hc = [r.summary()["hc_m"] for r in results]
     rich = hc[2] + (hc[2] - hc[1]) / 3.0
     errors = [abs(h / rich - 1.0) for h in hc]
     assert errors[0] > errors[1] > errors[2]
     assert errors[2] < 0.02
+    # each solve's own estimate of its error (from its full multigrid's coarser level)
+    for r, err in zip(results[1:], errors[1:]):
+        assert 0.5 * err < r.summary()["hc_grid_error"] < 2.0 * err
     order = math.log2(abs(hc[1] - hc[0]) / abs(hc[2] - hc[1]))
     assert 1.5 < order < 2.5
     between = solve(make_spec(**kw, grid=385))
@@ -297,3 +301,23 @@ def test_reference_operating_point_fine_grid():
     assert 0 < s["hmin_m"] < s["hc_m"]
     assert s["hc_m"] == pytest.approx(nvm_hc_m(r.contact), rel=0.25)
     assert s["hc_m"] == pytest.approx(hamrock_dowson(r.contact)[0], rel=0.25)
+
+
+def test_the_default_grid_follows_the_load_and_keys_the_cache():
+    """513 points a side below M = 300, 1025 below FINE_GRID_M, 2049 above (1025 leaves hc
+    more than 2 % off there); a default 2049 grid has its own precalc cache key, a grid the
+    spec names keeps the key it had."""
+    from ehlfoam.contact.solver import FINE_GRID_M, default_grid
+    from ehlfoam.gap.source import spec_key
+
+    assert [default_grid(M) for M in (100.0, 3886.0, FINE_GRID_M, 34000.0)] == [
+        513, 1025, 2049, 2049]
+    light, heavy = make_spec(speed=0.01), make_spec(speed=0.002)   # 40 C, 20 N: M 3886, 12994
+    assert light.contact().M < FINE_GRID_M <= heavy.contact().M
+    import hashlib
+    plain = [hashlib.sha256(s.model_dump_json(exclude={"inlet_layer", "inlet_meniscus",
+                                                         "twophase_coupling"}).encode())
+             .hexdigest()[:16] for s in (light, heavy)]
+    assert spec_key(light) == plain[0] and spec_key(heavy) != plain[1]
+    named = make_spec(speed=0.002, grid=2049)
+    assert spec_key(named) != spec_key(heavy)

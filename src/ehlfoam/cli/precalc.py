@@ -100,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
     spec = spec_from_args(args)
     check_output(args.out, "--out")            # before solving: a precalc that cannot write
     from ehlfoam.contact.outputs import write_all   # does not solve first
-    from ehlfoam.contact.solver import solve
+    from ehlfoam.contact.solver import GRID_ERROR_WARN, solve
 
     result = solve(spec)
     with removed_on_failure(args.out):
@@ -108,6 +108,12 @@ def run(args: argparse.Namespace) -> int:
     keys = ("M", "L", "hc_m", "hmin_m", "p_max_Pa", "converged", "residual", "load_error",
             "grid", "wall_s")
     print(json.dumps({k: summary[k] for k in keys}))
+    error = summary["hc_grid_error"]
+    if error is not None and error > GRID_ERROR_WARN:
+        print(f"ehlfoam precalc: warning: hc is some {error:.1%} or more off its "
+              f"grid-converged value on {summary['grid'][1]} points a side (the estimate's "
+              f"limit: {GRID_ERROR_WARN:.0%}): a finer --grid gives about a quarter of that "
+              f"per doubling (docs/models/contact.md)", file=sys.stderr)
     if not result.converged:
         print(f"ehlfoam precalc: NOT converged: {result.mg.failure}", file=sys.stderr)
         return EXIT_NOT_CONVERGED

@@ -17,7 +17,7 @@ from pathlib import Path
 from ehlfoam.gap.field import GapField
 from ehlfoam.paths import cache_dir
 from ehlfoam.contact.outputs import write_all
-from ehlfoam.contact.solver import solve
+from ehlfoam.contact.solver import FINE_GRID_M, default_grid, solve
 from ehlfoam.contact.spec import PrecalcSpec
 
 
@@ -28,11 +28,16 @@ class PrecalcFailed(RuntimeError):
 def spec_key(spec: PrecalcSpec) -> str:
     """A stable hash of everything that changes the solution (the starved-inlet keys only
     when set and the two-phase coupling only with the two-phase option, so a flooded
-    complementarity spec keeps the key it had before they existed)."""
+    complementarity spec keeps the key it had before they existed; the default grid by its
+    size where it is 2049, above FINE_GRID_M, so that a cache of the 1025 it was before
+    is not taken for it)."""
     unset = {k for k in ("inlet_layer", "inlet_meniscus") if getattr(spec, k) is None}
     if spec.cavitation != "twophase":
         unset.add("twophase_coupling")
-    return hashlib.sha256(spec.model_dump_json(exclude=unset).encode()).hexdigest()[:16]
+    text = spec.model_dump_json(exclude=unset)
+    if spec.grid is None and spec.contact().M >= FINE_GRID_M:
+        text += f"|default grid {default_grid(spec.contact().M)}"
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 def precalc_dir(spec: PrecalcSpec, cache: Path | None = None, require_converged: bool = True) -> Path:
