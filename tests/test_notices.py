@@ -3,12 +3,14 @@ back, shown once per batch; every warning the package raises fits the line."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from ehlfoam.case.geometry import BALL_WALL_STEPS_LIMIT, mesh_warnings
 from ehlfoam.notices import MAX_TEXT, Notice, NoticeTally, from_text, to_text
 from ehlfoam.run.monitor import (FRONT_CELL_WARNING, REAR_CELL_WARNING, boundary_warnings,
                                  front_cell_warnings, rear_cell_warnings)
+from ehlfoam.run.warnings import enclosure_warnings
 from tests.test_docs_links import ROOT, _anchors
 from tests.tiny import tiny_geometry
 
@@ -72,10 +74,11 @@ def test_every_warning_the_package_raises_is_a_notice_that_fits_at_extreme_value
     raised = [*mesh_warnings(tiny_geometry(ball_wall_steps=999.9)),
               *rear_cell_warnings(123.45), *front_cell_warnings(98765.0),
               *boundary_warnings(1.0, {"flooded_clearance_over_a": 0.0,
-                                       "flooded_nearest_boundary": "upstream"})]
+                                       "flooded_nearest_boundary": "upstream"}),
+              *enclosure_warnings({"enclosed_bubbles": 99}, np.zeros((9, 9), bool))]
     assert [n.code for n in raised] == ["ball-wall-steps", "rear-meniscus-cells",
                                         "front-contact-line-cells", "outflow-off-outlet",
-                                        "region-near-boundary"]
+                                        "region-near-boundary", "closed-within-a-cell"]
     assert all(n.docs.startswith("docs/") for n in raised)
     for n in raised:   # each pointer names a page and one of its sections
         page, _, anchor = n.docs.partition("#")
@@ -85,3 +88,8 @@ def test_every_warning_the_package_raises_is_a_notice_that_fits_at_extreme_value
     assert not mesh_warnings(tiny_geometry(ball_wall_steps=BALL_WALL_STEPS_LIMIT))
     assert not rear_cell_warnings(REAR_CELL_WARNING)
     assert not front_cell_warnings(FRONT_CELL_WARNING)
+    cavity = np.zeros((9, 9), bool)
+    assert not enclosure_warnings({"enclosed_bubbles": 0}, cavity)   # open wake: state II
+    assert not enclosure_warnings({"enclosed_bubbles": 1}, None)     # no outlet model
+    cavity[4, 4] = True                                               # the model's own cavity
+    assert not enclosure_warnings({"enclosed_bubbles": 1}, cavity)

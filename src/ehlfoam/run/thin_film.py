@@ -42,6 +42,7 @@ from ehlfoam.gap.field import GapField
 from ehlfoam.metrics.record import MetricsRecord, read_metrics, write_metrics
 from ehlfoam.run.fields import Sample
 from ehlfoam.run.history import write_history
+from ehlfoam.run.warnings import enclosure_warnings
 from ehlfoam.run.thin_film_record import (Accounts, earlier_samples, sample, thin_film_record,
                                           thin_film_steady)
 from ehlfoam.spec.case import CaseSpec
@@ -168,6 +169,7 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
     first = before = Accounts.of(m, t0)
     oil_start = m.oil()
     reason, kind, failure = None, None, None
+    enclosure: list = []
     t_wall = time.monotonic()
     try:
         with sigterm_interrupts():
@@ -207,7 +209,9 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
         if not history or history[-1].time < t0 + m.time * (1 - 1e-9):
             s, before = sample(m, t0, geom, before)
             history.append(s)
-        save_state(m.solution(reason == "steady"), path / STATE_FILE)
+        final = m.solution(reason == "steady")
+        save_state(final, path / STATE_FILE)
+        enclosure = enclosure_warnings(history[-1].pattern, final.cavity)
     write_history(path, history)
     if m.gas is not None:
         _write_gas(path, m)
@@ -217,7 +221,7 @@ def _run_locked(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: floa
         geom, history, status=status, reason=reason, steady_kind=kind, start=first,
         end=Accounts.of(m, t0), oil_start=oil_start, oil_end=m.oil(),
         oil_initial=initial if initial is not None else 2.0 * oil_start, steps=m.steps,
-        dt=m.dt, wall_s=wall, log_tail=tail)
+        dt=m.dt, wall_s=wall, log_tail=tail, notices=enclosure)
     if failure is not None:   # the one line a failed run's record gives (as the 3D runs')
         record = record.updated(reason="the march failed: " + " ".join(
             f"{type(failure).__name__}: {failure}".split())[:500])

@@ -16,7 +16,7 @@ import numpy as np
 from ehlfoam.case.geometry import CaseGeometry, mesh_warnings
 from ehlfoam.metrics.record import MetricsRecord
 from ehlfoam.metrics.thin_film import thin_film_pattern
-from ehlfoam.notices import to_text
+from ehlfoam.notices import Notice, to_text
 from ehlfoam.run.fields import Sample, off_outlet_share, pattern_geometry
 from ehlfoam.run.history import read_history
 from ehlfoam.run.steady import steady_test
@@ -117,12 +117,13 @@ def thin_film_steady(history: list[Sample], window: float, tol: float,
 def thin_film_record(geom: CaseGeometry, history: list[Sample], *, status: str, reason: str,
                      steady_kind: str | None, start: Accounts, end: Accounts,
                      oil_start: float, oil_end: float, oil_initial: float, steps: int,
-                     dt: float, wall_s: float, log_tail: list[str] | None = None
-                     ) -> MetricsRecord:
+                     dt: float, wall_s: float, log_tail: list[str] | None = None,
+                     notices: list[Notice] | None = None) -> MetricsRecord:
     """The run's metrics record: its end, the last write's flow pattern and outflow, the
     oil balance from ``start`` to ``end`` (the oil in the domain then, ``oil_start`` and
     ``oil_end`` [m3, half domain]; what the accounts say crossed the boundaries), its cost.
-    ``oil_initial``: the oil at t = 0 [m3, whole contact]."""
+    ``oil_initial``: the oil at t = 0 [m3, whole contact]; ``notices``: warnings of the
+    model's final state beside the mesh's and the boundaries'."""
     last = history[-1] if history else None
     pattern = dict(last.pattern) if last else {}
     off_outlet = off_outlet_share(last.oil_out_by_boundary) if last else None
@@ -153,7 +154,8 @@ def thin_film_record(geom: CaseGeometry, history: list[Sample], *, status: str, 
         "wall_s": wall_s,
         "wall_s_per_simulated_ms": wall_s / (1e3 * simulated) if simulated > 0 else None,
         "a_m": geom.a,
-        "warnings": to_text(mesh_warnings(geom) + boundary_warnings(off_outlet, pattern)),
+        "warnings": to_text(mesh_warnings(geom) + boundary_warnings(off_outlet, pattern)
+                            + list(notices or [])),
         "steady_test": steady_kind,
     }
     if log_tail:
