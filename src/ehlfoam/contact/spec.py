@@ -116,7 +116,7 @@ class PrecalcSpec(BaseModel):
         or three times one."""
         if v is None:
             return v
-        m = v - 1 if v - 1 > 0 else 0
+        m = max(v - 1, 0)
         while m and m % 2 == 0:
             m //= 2
         if not (GRID_MIN <= v <= GRID_MAX) or m not in (1, 3):

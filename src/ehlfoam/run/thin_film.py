@@ -42,9 +42,9 @@ from ehlfoam.gap.field import GapField
 from ehlfoam.metrics.record import MetricsRecord, read_metrics, write_metrics
 from ehlfoam.run.fields import Sample
 from ehlfoam.run.history import write_history
-from ehlfoam.run.warnings import enclosure_warnings
 from ehlfoam.run.thin_film_record import (Accounts, earlier_samples, sample, thin_film_record,
                                           thin_film_steady)
+from ehlfoam.run.warnings import enclosure_warnings
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.stop import wall_speed_at
 from ehlfoam.thinfilm.from_spec import problem_from_spec, scene_options
