@@ -167,10 +167,12 @@ def twophase(grids: tuple[int, ...], workers: int | None,
                              levels=levels, coupling_outer=s.get("coupling_outer"),
                              peak_GiB=s["peak_rss_GiB"],
                              load=s.get("load_average", [None])[0], failure=s.get("failure")))
-    coupled = {r["grid"][1] if isinstance(r["grid"], list) else r["grid"]: r
-               for r in rows if r["coupling"] == "coupled" and r["converged"]}
+    def rows_of(r: dict) -> int:   # points along y (a failed solve has no [nx, ny])
+        return r["grid"][1] if isinstance(r["grid"], list) else r["grid"]
+
+    coupled = {rows_of(r): r for r in rows if r["coupling"] == "coupled" and r["converged"]}
     for r in rows:
-        c = coupled.get(r["grid"][1] if isinstance(r["grid"], list) else r["grid"])
+        c = coupled.get(rows_of(r))
         if r["coupling"] == "one-way" and c is not None and r["converged"]:
             r.update(hc_err=r["hc_nm"] / c["hc_nm"] - 1.0,
                      hmin_err=r["hmin_nm"] / c["hmin_nm"] - 1.0,

@@ -347,8 +347,8 @@ def solve(spec: PrecalcSpec, options: SolverOptions | None = None,
         if not coupled_ok and result.converged and subambient.converged:
             result.converged = False
             result.failure = (f"two-phase coupling not converged in {len(outer)} outer "
-                              f"iterations (film error {outer[-1]['film_error_over_hc']:.3g} "
-                              f"of hc, tolerance {coupling.tol:g})" if outer else
+                              f"iterations (film error {film_err:.3g} of hc, tolerance "
+                              f"{coupling.tol:g})" if outer else
                               "two-phase coupling not converged")
         subambient.deformation_max = subambient_deformation(result.P, dom.h, result.x,
                                                             result.y)

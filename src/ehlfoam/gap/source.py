@@ -35,8 +35,10 @@ def spec_key(spec: PrecalcSpec) -> str:
     if spec.cavitation != "twophase":
         unset.add("twophase_coupling")
     text = spec.model_dump_json(exclude=unset)
-    if spec.grid is None and spec.contact().M >= FINE_GRID_M:
-        text += f"|default grid {default_grid(spec.contact().M)}"
+    if spec.grid is None:
+        M = spec.contact().M
+        if M >= FINE_GRID_M:
+            text += f"|default grid {default_grid(M)}"
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
