@@ -156,6 +156,27 @@ def test_a_march_with_the_balance_keeps_its_oil_and_closes_its_gas_budget(tmp_pa
     assert abs(again.gas.budget_residual()) < 1e-9 * g.held()
 
 
+def test_a_state_on_another_grid_hands_its_bubble_its_air():
+    """A march on cells half the size, started from a state on the coarser cells, starts
+    with the state's air in its bubble (not empty at the release pressure, to fill again by
+    diffusion over tens of transits), its pressure near the state's."""
+    k = GasBalance(solubility=0.09, diffusivity=1e-9, temperature=T, ambient=P_ATM,
+                   release=P_ATM - 8e3)
+    coarse = Marcher(_ball(gas=k), transit_length=10 * A)
+    for _ in range(6 * coarse.steps_per_transit):
+        coarse.step()
+    sol = coarse.solution()
+    fine = Marcher(_ball(gas=k, cell=0.2 * A), start=sol, transit_length=10 * A)
+    assert fine.cavity().any()
+    assert fine.gas.held() == pytest.approx(coarse.gas.held(), rel=1e-12)
+    p_coarse = coarse.gas.pressure(coarse.cavity(), coarse.c)[coarse.cavity()].max()
+    p_fine = fine.gas.pressure(fine.cavity(), fine.c)[fine.cavity()].max()
+    assert p_fine == pytest.approx(p_coarse, rel=0.1)
+    assert p_fine > P_ATM - 8e3 + 1.0          # above the release pressure: its air's
+    fine.step()
+    assert abs(fine.gas.budget_residual()) < 1e-9 * fine.gas.held()
+
+
 def test_the_gas_needs_an_outlet_and_its_constants_are_checked():
     k = GasBalance(solubility=0.09, diffusivity=1e-9, temperature=T, ambient=P_ATM,
                    release=P_R)

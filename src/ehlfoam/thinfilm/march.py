@@ -75,7 +75,8 @@ import numpy as np
 from ehlfoam.thinfilm.gas import CavityGas
 from ehlfoam.thinfilm.operators import Operators
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
-from ehlfoam.thinfilm.solution import ThinFilmSolution, connected_region, oil_fraction_on
+from ehlfoam.thinfilm.solution import (ThinFilmSolution, connected_region, gas_on,
+                                       oil_fraction_on)
 
 __all__ = ["Marcher", "solve_thin_film"]
 
@@ -132,9 +133,8 @@ class Marcher:
         self.history: list[dict] = []
         self._out = self._dry = self._cavitated = self._in = 0.0
         self.gas = None if prob.gas is None else CavityGas(prob.gas, h, grid.hx, grid.hy, d, u)
-        if self.gas is not None and start is not None and start.gas is not None \
-                and start.gas.shape == h.shape:     # the air of a state on this grid
-            self.gas.n = np.where(self.cavity(), start.gas, 0.0)
+        if self.gas is not None and start is not None and start.gas is not None:
+            self.gas.n = gas_on(start, grid, self.cavity())   # the air of its bubbles
             self.gas.start = self.gas.held()
 
     def set_supply(self, layers: tuple[np.ndarray, np.ndarray]) -> None:

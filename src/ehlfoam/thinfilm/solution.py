@@ -164,3 +164,20 @@ def oil_fraction_on(sol: ThinFilmSolution, grid: Grid) -> np.ndarray:
     frac = np.where(sol.grid.h > 0, sol.content / np.where(sol.grid.h > 0, sol.grid.h, 1), 0.0)
     X, Y = np.meshgrid(grid.x, grid.y)
     return np.where(grid.island, 0.0, _nearest_cell(sol.grid, np.nan_to_num(frac), X, Y))
+
+
+def gas_on(sol: ThinFilmSolution, grid: Grid, cavity: np.ndarray) -> np.ndarray:
+    """The air [mol] that the cavities of ``sol`` hold, on the cells ``cavity`` of ``grid``:
+    the same cells' amounts on the same grid; on another grid, the amount per area of the
+    nearest cell, scaled so that the total is the state's (a bubble refined or coarsened keeps
+    its air, so its pressure starts where it was; a cell the start's cavity did not cover
+    starts empty, its cavity's pressure set by the whole cavity's air). None held, or no
+    cavity to hold it: zeros."""
+    n = np.nan_to_num(np.asarray(sol.gas, float))
+    if np.array_equal(sol.grid.x, grid.x) and np.array_equal(sol.grid.y, grid.y):
+        return np.where(cavity, n, 0.0)
+    X, Y = np.meshgrid(grid.x, grid.y)
+    per_area = _nearest_cell(sol.grid, n / sol.grid.cell ** 2, X, Y)
+    out = np.where(cavity, per_area * grid.cell ** 2, 0.0)
+    total, got = float(n.sum()), float(out.sum())
+    return out * (total / got) if got > 0 else out
