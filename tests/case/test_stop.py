@@ -11,6 +11,7 @@ from foamlib import FoamFieldFile
 
 from ehlfoam.case.geometry import load_geometry
 from ehlfoam.case.writer import write_case
+from ehlfoam.report.case_report import report_case
 from ehlfoam.report.stop import make_stop_pictures
 from ehlfoam.errors import SpecError
 from ehlfoam.run import fields as case_fields
@@ -64,6 +65,10 @@ def test_the_walls_of_a_3d_case_slow_to_rest_as_the_stop_says(tmp_path, scene):
         assert r["from_stop_s"] == pytest.approx(r["time_s"] - STOP["at"])
         assert r["wall_speed_m_s"] == pytest.approx(wall_speed_at(spec.stop, u, r["time_s"]))
         assert r["state"] in ("I", "II") and r["flooded_length_over_a"] > 0
+    # the case report draws the stop's GIF and not the same written times again
+    report_case(case)
+    assert (case / "report" / "stop.gif").is_file()
+    assert not (case / "report" / "transient.gif").exists()
 
 
 def test_a_stop_with_slip_walls_or_still_walls_is_refused():

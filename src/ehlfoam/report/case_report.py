@@ -212,10 +212,12 @@ def _report_case(case_dir: str | os.PathLike, animate: bool, gif_frames: int) ->
         steps.run("pressure map", _pressure, info, fields, out, page)
     steps.run("precalc picture", _precalc, info, out, page)
     settle = steps.run("history chart", _history, info, out, page)
-    if animate and fields is not None and not thin:
+    stops = (info.geom is not None and info.spec is not None
+             and info.spec.stop.at is not None and (thin or fields is not None))
+    if animate and fields is not None and not thin and not stops:
+        # a 3D stop's GIF draws the same written times, labelled: one GIF, not two
         steps.run("transient GIF", _gif, info, fields, out, page, gif_frames)
-    if animate and info.geom is not None and info.spec is not None \
-            and info.spec.stop.at is not None and (thin or fields is not None):
+    if animate and stops:
         steps.run("stop GIF", _stop, info, out, page, not thin)
     if summary_top:
         page.summary.extend(summary_top)
