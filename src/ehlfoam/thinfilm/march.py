@@ -105,7 +105,8 @@ class Marcher:
     :func:`ehlfoam.spec.stop.wall_speed_at`); each step takes it at the step's middle and
     scales every flux the walls drive by it (Couette, the supply, the films a receding
     meniscus lays, the gas's exchange), the step staying the one of ``prob.speed``, the
-    speed the march starts at. None: ``prob.speed`` throughout."""
+    speed the march starts at; with the walls at rest it is taken in sub-steps that resolve
+    the capillary flow (:meth:`_at_rest`). None: ``prob.speed`` throughout."""
 
     def __init__(self, prob: ThinFilmProblem, *, start: ThinFilmSolution | None = None,
                  courant: float = 0.25, transit_length: float | None = None,
