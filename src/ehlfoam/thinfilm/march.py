@@ -205,8 +205,8 @@ class Marcher:
         the gap is 20 um), far shorter than a step sized by the rolling speed. The step is
         taken in sub-steps, each halved (at most ``REST_HALVINGS`` times) until no open cell
         would end it holding more than ``REST_OVERFILL`` of its gap beyond full; with a
-        step too long, cells that flood overshoot by up to half their gap, return it the
-        next step and flood again, and a pocket of gas that the capillary pull should carry
+        step too long, cells that flood overshoot by up to 1.5 times their gap, return it
+        the next step and flood again, and a pocket of gas that the capillary pull should carry
         to the wider gap stays where it is."""
         left = self.dt
         while left > 1e-9 * self.dt:
