@@ -73,7 +73,7 @@ from dataclasses import replace
 import numpy as np
 
 from ehlfoam.thinfilm.gas import CavityGas
-from ehlfoam.thinfilm.operators import Operators
+from ehlfoam.thinfilm.operators import Operators, Step
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 from ehlfoam.thinfilm.solution import (ThinFilmSolution, connected_region, gas_on,
                                        oil_fraction_on)
@@ -192,7 +192,7 @@ class Marcher:
         if self.steps % self.steps_per_transit == 0:
             self.history.append(self._record())
 
-    def _solve(self, dt: float):
+    def _solve(self, dt: float) -> Step:
         """The step of ``dt`` [s] from the state now (:meth:`Operators.step`), nothing moved."""
         gas, c_old = self.gas, self.c
         return self.ops.step(self.flooded, c_old, dt,
@@ -221,7 +221,7 @@ class Marcher:
             self._advance(s, sub)
             left -= sub
 
-    def _advance(self, s, dt: float) -> None:
+    def _advance(self, s: Step, dt: float) -> None:
         """Move the oil and the gas by the solved step ``s`` of ``dt`` [s] and book it."""
         gas = self.gas
         c_old, flooded_old = self.c, self.flooded
