@@ -163,7 +163,12 @@ def nothing_beside(tmp: Path, keep: set[str]) -> None:
 
 
 def times(case: Path) -> int:
-    return len(case_fields.time_folders(case)) if case.is_dir() else 0
+    """Time folders in ``case``; 0 when it is absent or vanishes while read (a
+    staging folder the builder renames into place)."""
+    try:
+        return len(case_fields.time_folders(case))
+    except (FileNotFoundError, NotADirectoryError):
+        return 0
 
 
 def kill_when(proc: subprocess.Popen, ready: Callable[[], bool], what: str,
@@ -545,7 +550,8 @@ def batch_during_build(tmp: Path, lab: Lab) -> Result:
 
 
 def _solving(batch: Path, sub: str = "") -> bool:
-    return any(times(c / sub) >= 2 for c in batch.glob("cases/*"))
+    return any(times(c / sub) >= 2 for c in batch.glob("cases/*")
+               if not c.name.startswith("."))
 
 
 def batch_during_solver(tmp: Path, lab: Lab) -> Result:
