@@ -70,6 +70,19 @@ def spec_option(text: str) -> tuple[str, Any]:
     return key, parse_value(value)
 
 
+def count_option(low: int, high: int):
+    """An argparse type: an integer in [low, high], refused with the range named."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{text!r}: must be an integer in [{low}, {high}]")
+        return value
+    return parse
+
+
 def add_output_options(ap: argparse.ArgumentParser, work: bool = False) -> None:
     """``--quick``, ``--out FILE.json`` and, for benchmarks that write cases, ``--work DIR``."""
     ap.add_argument("--quick", action="store_true",

@@ -2,21 +2,22 @@
 error of each rung against the finest that comes to rest, against its CPU cost.
 
     python bench/ladder_accuracy.py [--rungs R ...] [--points N ...] [--cap-s S]
-        [--charts DIR] [--work DIR] [--out FILE.json]
+        [--procs N] [--jobs N] [--charts DIR] [--work DIR] [--out FILE.json]
     python bench/ladder_accuracy.py --quick
 
 The reference points (HVI60, 20 N, gas below 90 kPa, layers on disc and ball over a +-0.3 mm
 track; the default batch's conditions): 40 C at 8 and 17 mm/s with 0.45 and 1 um layers
 (both states), 25 C and 60 C at 12 mm/s with 0.45 um. Each point is written and run on each
-rung (``ehlfoam case --rung`` + ``ehlfoam run``, one after the other, one core): the thin-film
+rung (``ehlfoam case --rung`` + ``ehlfoam run``; one after the other on one core, or
+``--jobs`` cases side by side, the 3D ones on ``--procs`` MPI ranks each): the thin-film
 levels to rest (150 transits at most); the 3D rungs in the gas-release scene (the thin-film
 outlet's counterpart), started from the point's thin-film balance, capped at ``--cap-s`` of
 wall time and 6 transits. The reference of a point is the finest rung (the last of
 ``--rungs``) that came to rest (``steady``). Per metric (state, inlet meniscus, flooded
 width, bubble or wake length, oil held) each rung's error against it: the state right or
 wrong, the others relative. Cost: the CPU time of the run (the process's own, the thin-film
-start included, plus the OpenFOAM solver's), the EHL precalc excluded (solved first,
-cached). Prints a row per point and rung and a summary per rung (error, median CPU, CPU
+start included, plus the OpenFOAM solver's on every rank), the EHL precalc excluded (solved
+first, cached). Prints a row per point and rung and a summary per rung (error, median CPU, CPU
 against the reference's); ``--charts DIR`` draws one chart per metric, error against CPU
 (log axis), a marker per rung. ``--quick``: two points on the two cheapest thin-film levels
 over a small domain (seconds).
@@ -27,9 +28,12 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import nullcontext
 from pathlib import Path
 
-from common import add_output_options, print_table, solver_cpu_s, work_folder, write_out
+from common import (add_output_options, count_option, print_table, solver_cpu_s, work_folder,
+                    write_out)
 from ehlfoam.case.writer import write_case
 from ehlfoam.gap.source import precalc_dir
 from ehlfoam.run.monitor import run_case
@@ -55,8 +59,8 @@ METRICS = {"inlet": "inlet_meniscus_distance_over_a", "width": "flooded_width_ov
            "oil": "oil_volume_m3"}
 
 
-def point_spec(point: tuple, rung: str, base: dict, cap_s: float):
-    """The case spec of a reference point on a rung."""
+def point_spec(point: tuple, rung: str, base: dict, cap_s: float, procs: int = 1):
+    """The case spec of a reference point on a rung (a 3D rung on ``procs`` MPI ranks)."""
     _, temperature, speed, layer = point
     data = {**base, "contact": {**base["contact"], "speed": speed,
                                 "temperature": temperature},
@@ -65,13 +69,15 @@ def point_spec(point: tuple, rung: str, base: dict, cap_s: float):
         data["run"] = {"transits_max": 150.0}
     else:
         data.update(scene="gas-release", run={"start": "thin-film", "transits_max": 6.0,
-                                              "wall_limit": cap_s})
+                                              "wall_limit": cap_s, "n_procs": procs})
     return make_case_spec(data, rung=rung)
 
 
-def run_point(point: tuple, rung: str, base: dict, cap_s: float, case: Path) -> dict:
-    """Write and run one point on one rung: its metrics, end and CPU [s]."""
-    spec = point_spec(point, rung, base, cap_s)
+def run_point(point: tuple, rung: str, base: dict, cap_s: float, case: Path,
+              procs: int = 1) -> dict:
+    """Write and run one point on one rung: its metrics, end and CPU [s] (the solver's
+    on every rank: its master's ``ExecutionTime`` times the ranks)."""
+    spec = point_spec(point, rung, base, cap_s, procs)
     precalc_dir(spec.contact)                       # solved before the clock starts
     c0, t0 = time.process_time(), time.perf_counter()
     if spec.scene == "thin-film":
@@ -79,12 +85,28 @@ def run_point(point: tuple, rung: str, base: dict, cap_s: float, case: Path) -> 
     else:
         write_started_case(spec, case, None, overwrite=True)
     m = run_case(case)
-    cpu = time.process_time() - c0 + (solver_cpu_s(case) or 0.0)
+    cpu = time.process_time() - c0 + (solver_cpu_s(case) or 0.0) * spec.run.n_procs
     row = {"point": point[0], "rung": rung, "cpu_s": cpu, "wall_s": time.perf_counter() - t0,
            "end_reason": m.get("end_reason"), "steady": bool(m.get("steady")),
            "state": m.get("state")}
     row.update({name: m.get(key) for name, key in METRICS.items()})
     return row
+
+
+def run_all(points: list[tuple], rungs: list[str], base: dict, args: argparse.Namespace,
+            work: Path) -> list[dict]:
+    """Every point on every rung, ``args.jobs`` at a time: the rows in point, rung order."""
+    tasks = [(point, rung, base, args.cap_s,
+              work / f"{point[0].replace(' ', '_').replace('/', '')}_{rung}", args.procs)
+             for point in points for rung in rungs]
+    with ProcessPoolExecutor(args.jobs) if args.jobs > 1 else nullcontext() as pool:
+        runs = pool.map(run_point, *zip(*tasks)) if pool else map(run_point, *zip(*tasks))
+        rows = []
+        for r in runs:
+            rows.append(r)
+            print(f"{r['point']} {r['rung']}: {r['state']} {r['end_reason']} "
+                  f"{r['cpu_s']:.1f} s CPU", flush=True)
+    return rows
 
 
 def errors(rows: list[dict], rungs: list[str]) -> dict[str, dict]:
@@ -168,6 +190,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="indices into the reference points (0-5)")
     ap.add_argument("--cap-s", type=float, default=1200.0,
                     help="wall-time cap of a 3D run [s] (default 1200)")
+    ap.add_argument("--procs", type=count_option(1, 64), default=1, metavar="N",
+                    help="MPI ranks of each 3D case (1-64, default 1)")
+    ap.add_argument("--jobs", type=count_option(1, 64), default=1, metavar="N",
+                    help="cases run side by side (1-64, default 1)")
     ap.add_argument("--charts", type=Path, default=None, metavar="DIR",
                     help="draw one chart per metric into DIR")
     add_output_options(ap, work=True)
@@ -176,15 +202,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.quick:
         base = {**BASE, **QUICK, "contact": {**BASE["contact"], **QUICK["contact"]}}
         rungs, points = ["thin-film-coarse", "thin-film-medium"], [POINTS[0], POINTS[2]]
-    rows = []
     with work_folder(args.work) as work:
-        for point in points:
-            for rung in rungs:
-                case = work / f"{point[0].replace(' ', '_').replace('/', '')}_{rung}"
-                rows.append(run_point(point, rung, base, args.cap_s, case))
-                r = rows[-1]
-                print(f"{r['point']} {rung}: {r['state']} {r['end_reason']} "
-                      f"{r['cpu_s']:.1f} s CPU", flush=True)
+        rows = run_all(points, rungs, base, args, work)
     errors(rows, rungs)
     print_table(rows, [
         ("point", "point", ""), ("rung", "rung", ""), ("end_reason", "end", ""),
@@ -206,7 +225,8 @@ def main(argv: list[str] | None = None) -> int:
         for path in charts(rows, rungs, args.charts):
             print(f"chart {path}")
     write_out(args.out, {"rungs": rungs, "points": [p[0] for p in points],
-                         "cap_s": args.cap_s, "rows": rows, "summary": table})
+                         "cap_s": args.cap_s, "procs": args.procs, "jobs": args.jobs,
+                         "rows": rows, "summary": table})
     return 0
 
 

@@ -128,9 +128,11 @@ def test_strips_lay_films_near_landau_levich_and_hold_a_contact_line(tmp_path):
 def test_ladder_accuracy_measures_each_rung_against_the_finest_at_rest(tmp_path):
     """Two points on the two cheapest thin-film levels: the finer one at rest is each
     point's reference (its own errors zero), the coarser one's errors are its metrics'
-    distance from it, and the summary has a row per rung with its cost."""
-    stdout, rec = run_bench("ladder_accuracy", tmp_path)
+    distance from it, and the summary has a row per rung with its cost. Two cases at a
+    time (``--jobs 2``): the rows still in point, rung order."""
+    stdout, rec = run_bench("ladder_accuracy", tmp_path, "--jobs", "2")
     rows = rec["rows"]
+    assert rec["jobs"] == 2
     assert [(r["point"], r["rung"]) for r in rows] == [
         (p, r) for p in rec["points"] for r in ("thin-film-coarse", "thin-film-medium")]
     for r in rows:
