@@ -70,3 +70,14 @@ def test_the_first_screen_says_what_and_how_far(tmp_path):
     assert TRUST["thin-film"] in lines[0] and TRUST["coarse"] in lines[1]
     assert trust_lines([{"scene": "interface", "mesh.resolution": "fine"}]) == [
         f"How far to trust it: {TRUST['fine']}"]
+
+
+def test_a_live_batchs_staging_folders_are_not_cases(tmp_path):
+    """A case folder being built or replaced lives under a dot name (``.ID.XXXX``,
+    ``.ID.old.XXXX``) until it is renamed into place: a report of a running batch lists
+    the real folder that has no row yet, and not the staging ones."""
+    _write(tmp_path / "b", ["case_id", "status"], [{"case_id": "a", "status": "finished"}],
+           [{"id": "a", "params": {}}])
+    for name in ("a", "c", ".c.k2j9x", ".a.old.q1w2e"):
+        (tmp_path / "b" / "cases" / name).mkdir(parents=True)
+    assert [r["case_id"] for r in read_results(tmp_path / "b")] == ["a", "c"]

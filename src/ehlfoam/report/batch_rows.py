@@ -64,7 +64,8 @@ def _current(row: dict[str, Any]) -> dict[str, Any]:
 
 def read_results(batch: Path) -> list[dict]:
     """results.csv rows (numbers as floats), plus planned cases missing from it (status
-    "pending") and case folders missing from both."""
+    "pending") and case folders missing from both (not the dot-named folders a case is
+    built or replaced in before it is renamed into place)."""
     rows: list[dict] = []
     path = batch / "results.csv"
     if path.is_file():
@@ -83,7 +84,7 @@ def read_results(batch: Path) -> list[dict]:
     cases = batch / "cases"
     if cases.is_dir():
         for folder in sorted(p for p in cases.iterdir() if p.is_dir()):
-            if folder.name not in known:
+            if folder.name not in known and not folder.name.startswith("."):  # staging
                 rows.append({"case_id": folder.name, "status": None})
     for row in rows:
         cid = str(row.get("case_id"))
