@@ -2,7 +2,8 @@
 error of each rung against the finest that comes to rest, against its CPU cost.
 
     python bench/ladder_accuracy.py [--rungs R ...] [--points N ...] [--cap-s S]
-        [--procs N] [--jobs N] [--charts DIR] [--work DIR] [--out FILE.json]
+        [--procs N] [--jobs N] [--set KEY=VALUE ...] [--charts DIR] [--work DIR]
+        [--out FILE.json]
     python bench/ladder_accuracy.py --quick
 
 The reference points (HVI60, 20 N, gas below 90 kPa, layers on disc and ball over a +-0.3 mm
@@ -32,8 +33,8 @@ from concurrent.futures import ProcessPoolExecutor
 from contextlib import nullcontext
 from pathlib import Path
 
-from common import (add_output_options, count_option, print_table, solver_cpu_s, work_folder,
-                    write_out)
+from common import (add_output_options, count_option, print_table, solver_cpu_s,
+                    spec_option, work_folder, write_out)
 from ehlfoam.case.writer import write_case
 from ehlfoam.gap.source import precalc_dir
 from ehlfoam.run.monitor import run_case
@@ -59,8 +60,10 @@ METRICS = {"inlet": "inlet_meniscus_distance_over_a", "width": "flooded_width_ov
            "oil": "oil_volume_m3"}
 
 
-def point_spec(point: tuple, rung: str, base: dict, cap_s: float, procs: int = 1):
-    """The case spec of a reference point on a rung (a 3D rung on ``procs`` MPI ranks)."""
+def point_spec(point: tuple, rung: str, base: dict, cap_s: float, procs: int = 1,
+               overrides: dict | None = None):
+    """The case spec of a reference point on a rung (a 3D rung on ``procs`` MPI ranks),
+    with ``overrides`` (dotted spec keys, as ``ehlfoam case --set``)."""
     _, temperature, speed, layer = point
     data = {**base, "contact": {**base["contact"], "speed": speed,
                                 "temperature": temperature},
@@ -70,14 +73,14 @@ def point_spec(point: tuple, rung: str, base: dict, cap_s: float, procs: int = 1
     else:
         data.update(scene="gas-release", run={"start": "thin-film", "transits_max": 6.0,
                                               "wall_limit": cap_s, "n_procs": procs})
-    return make_case_spec(data, rung=rung)
+    return make_case_spec(data, rung=rung, **(overrides or {}))
 
 
 def run_point(point: tuple, rung: str, base: dict, cap_s: float, case: Path,
-              procs: int = 1) -> dict:
+              procs: int = 1, overrides: dict | None = None) -> dict:
     """Write and run one point on one rung: its metrics, end and CPU [s] (the solver's
     on every rank: its master's ``ExecutionTime`` times the ranks)."""
-    spec = point_spec(point, rung, base, cap_s, procs)
+    spec = point_spec(point, rung, base, cap_s, procs, overrides)
     precalc_dir(spec.contact)                       # solved before the clock starts
     c0, t0 = time.process_time(), time.perf_counter()
     if spec.scene == "thin-film":
@@ -97,7 +100,8 @@ def run_all(points: list[tuple], rungs: list[str], base: dict, args: argparse.Na
             work: Path) -> list[dict]:
     """Every point on every rung, ``args.jobs`` at a time: the rows in point, rung order."""
     tasks = [(point, rung, base, args.cap_s,
-              work / f"{point[0].replace(' ', '_').replace('/', '')}_{rung}", args.procs)
+              work / f"{point[0].replace(' ', '_').replace('/', '')}_{rung}", args.procs,
+              dict(args.set))
              for point in points for rung in rungs]
     with ProcessPoolExecutor(args.jobs) if args.jobs > 1 else nullcontext() as pool:
         runs = pool.map(run_point, *zip(*tasks)) if pool else map(run_point, *zip(*tasks))
@@ -194,6 +198,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="MPI ranks of each 3D case (1-64, default 1)")
     ap.add_argument("--jobs", type=count_option(1, 64), default=1, metavar="N",
                     help="cases run side by side (1-64, default 1)")
+    ap.add_argument("--set", action="append", default=[], type=spec_option,
+                    metavar="KEY=VALUE", help="a spec option on every case (repeatable)")
     ap.add_argument("--charts", type=Path, default=None, metavar="DIR",
                     help="draw one chart per metric into DIR")
     add_output_options(ap, work=True)
@@ -226,6 +232,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"chart {path}")
     write_out(args.out, {"rungs": rungs, "points": [p[0] for p in points],
                          "cap_s": args.cap_s, "procs": args.procs, "jobs": args.jobs,
+                         "set": dict(args.set),
                          "rows": rows, "summary": table})
     return 0
 
