@@ -36,6 +36,7 @@ from pathlib import Path
 from common import (add_output_options, count_option, print_table, solver_cpu_s,
                     spec_option, work_folder, write_out)
 from ehlfoam.case.writer import write_case
+from ehlfoam.errors import SpecError
 from ehlfoam.gap.source import precalc_dir
 from ehlfoam.run.monitor import run_case
 from ehlfoam.seed.follow import write_started_case
@@ -208,6 +209,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.quick:
         base = {**BASE, **QUICK, "contact": {**BASE["contact"], **QUICK["contact"]}}
         rungs, points = ["thin-film-coarse", "thin-film-medium"], [POINTS[0], POINTS[2]]
+    try:                                            # every spec checked before any run
+        for point in points:
+            for rung in rungs:
+                point_spec(point, rung, base, args.cap_s, args.procs, dict(args.set))
+    except SpecError as err:
+        ap.error(str(err))
     with work_folder(args.work) as work:
         rows = run_all(points, rungs, base, args, work)
     errors(rows, rungs)

@@ -146,6 +146,14 @@ def test_ladder_accuracy_measures_each_rung_against_the_finest_at_rest(tmp_path)
     assert len(table_rows(stdout, "rung  points")) == 2
 
 
+def test_ladder_accuracy_refuses_a_bad_spec_option_before_any_run(tmp_path):
+    proc = subprocess.run([sys.executable, "bench/ladder_accuracy.py", "--quick", "--set",
+                           "thin_film.courant=7", "--work", str(tmp_path / "w")],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "thin_film.courant = 7" in proc.stderr, proc.stderr
+    assert not (tmp_path / "w").exists()
+
+
 @pytest.mark.slow
 def test_starved_film_follows_the_starvation_relations(tmp_path):
     stdout, rec = run_bench("starved_film", tmp_path)
