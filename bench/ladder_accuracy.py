@@ -40,7 +40,7 @@ from ehlfoam.errors import SpecError
 from ehlfoam.gap.source import precalc_dir
 from ehlfoam.run.monitor import run_case
 from ehlfoam.seed.follow import write_started_case
-from ehlfoam.spec.case import make_case_spec
+from ehlfoam.spec.case import CaseSpec, make_case_spec
 
 #: the default batch's conditions (examples/batches/default.toml)
 BASE = {"contact": {"load": 20.0, "lubricant": "HVI60"},
@@ -62,7 +62,7 @@ METRICS = {"inlet": "inlet_meniscus_distance_over_a", "width": "flooded_width_ov
 
 
 def point_spec(point: tuple, rung: str, base: dict, cap_s: float, procs: int = 1,
-               overrides: dict | None = None):
+               overrides: dict | None = None) -> CaseSpec:
     """The case spec of a reference point on a rung (a 3D rung on ``procs`` MPI ranks),
     with ``overrides`` (dotted spec keys, as ``ehlfoam case --set``)."""
     _, temperature, speed, layer = point
@@ -77,11 +77,10 @@ def point_spec(point: tuple, rung: str, base: dict, cap_s: float, procs: int = 1
     return make_case_spec(data, rung=rung, **(overrides or {}))
 
 
-def run_point(point: tuple, rung: str, base: dict, cap_s: float, case: Path,
-              procs: int = 1, overrides: dict | None = None) -> dict:
-    """Write and run one point on one rung: its metrics, end and CPU [s] (the solver's
-    on every rank: its master's ``ExecutionTime`` times the ranks)."""
-    spec = point_spec(point, rung, base, cap_s, procs, overrides)
+def run_point(label: str, rung: str, spec: CaseSpec, case: Path) -> dict:
+    """Write and run the point ``label`` on ``rung`` (its case spec ``spec``): its metrics,
+    end and CPU [s] (the solver's on every rank: its master's ``ExecutionTime`` times the
+    ranks)."""
     precalc_dir(spec.contact)                       # solved before the clock starts
     c0, t0 = time.process_time(), time.perf_counter()
     if spec.scene == "thin-film":
@@ -90,21 +89,19 @@ def run_point(point: tuple, rung: str, base: dict, cap_s: float, case: Path,
         write_started_case(spec, case, None, overwrite=True)
     m = run_case(case)
     cpu = time.process_time() - c0 + (solver_cpu_s(case) or 0.0) * spec.run.n_procs
-    row = {"point": point[0], "rung": rung, "cpu_s": cpu, "wall_s": time.perf_counter() - t0,
+    row = {"point": label, "rung": rung, "cpu_s": cpu, "wall_s": time.perf_counter() - t0,
            "end_reason": m.get("end_reason"), "steady": bool(m.get("steady")),
            "state": m.get("state")}
     row.update({name: m.get(key) for name, key in METRICS.items()})
     return row
 
 
-def run_all(points: list[tuple], rungs: list[str], base: dict, args: argparse.Namespace,
-            work: Path) -> list[dict]:
-    """Every point on every rung, ``args.jobs`` at a time: the rows in point, rung order."""
-    tasks = [(point, rung, base, args.cap_s,
-              work / f"{point[0].replace(' ', '_').replace('/', '')}_{rung}", args.procs,
-              dict(args.set))
-             for point in points for rung in rungs]
-    with ProcessPoolExecutor(args.jobs) if args.jobs > 1 else nullcontext() as pool:
+def run_all(specs: list[tuple], jobs: int, work: Path) -> list[dict]:
+    """Every (point label, rung, spec) of ``specs``, ``jobs`` at a time: the rows in the
+    same order."""
+    tasks = [(label, rung, spec, work / f"{label.replace(' ', '_').replace('/', '')}_{rung}")
+             for label, rung, spec in specs]
+    with ProcessPoolExecutor(jobs) if jobs > 1 else nullcontext() as pool:
         runs = pool.map(run_point, *zip(*tasks)) if pool else map(run_point, *zip(*tasks))
         rows = []
         for r in runs:
@@ -210,13 +207,13 @@ def main(argv: list[str] | None = None) -> int:
         base = {**BASE, **QUICK, "contact": {**BASE["contact"], **QUICK["contact"]}}
         rungs, points = ["thin-film-coarse", "thin-film-medium"], [POINTS[0], POINTS[2]]
     try:                                            # every spec checked before any run
-        for point in points:
-            for rung in rungs:
-                point_spec(point, rung, base, args.cap_s, args.procs, dict(args.set))
+        specs = [(point[0], rung, point_spec(point, rung, base, args.cap_s, args.procs,
+                                             dict(args.set)))
+                 for point in points for rung in rungs]
     except SpecError as err:
         ap.error(str(err))
     with work_folder(args.work) as work:
-        rows = run_all(points, rungs, base, args, work)
+        rows = run_all(specs, args.jobs, work)
     errors(rows, rungs)
     print_table(rows, [
         ("point", "point", ""), ("rung", "rung", ""), ("end_reason", "end", ""),
