@@ -29,24 +29,17 @@ that of the air it holds, and its menisci are Young-Laplace's below it.
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage
+
+from ehlfoam.thinfilm.kernels import edge_connected
 
 __all__ = ["cavities", "outer_air"]
-
-_FOUR = ndimage.generate_binary_structure(2, 1)
 
 
 def outer_air(gas: np.ndarray, closed_side: bool = False) -> np.ndarray:
     """The cells of ``gas`` (bool, ny x nx: the open cells) connected through other gas cells
     (4-neighbours) to the domain's open edges: the upstream column, the outlet column and,
     unless ``closed_side``, the side row y = y_max (row 0 is the symmetry plane y = 0)."""
-    labels, _ = ndimage.label(gas, structure=_FOUR)
-    edge = np.zeros_like(gas)
-    edge[:, 0] = edge[:, -1] = True
-    if not closed_side:
-        edge[-1] = True
-    keep = np.unique(labels[edge & gas])
-    return np.isin(labels, keep[keep > 0])
+    return edge_connected(np.ascontiguousarray(gas, dtype=np.bool_), closed_side)
 
 
 def cavities(flooded: np.ndarray, island: np.ndarray, closed_side: bool = False) -> np.ndarray:

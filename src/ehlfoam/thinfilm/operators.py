@@ -10,10 +10,11 @@ from typing import NamedTuple
 
 import numpy as np
 from scipy import ndimage
-from scipy.sparse import coo_matrix
+from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
 from ehlfoam.thinfilm.cavity import cavities
+from ehlfoam.thinfilm.kernels import meniscus_faces, pressure_system
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
@@ -117,76 +118,32 @@ class Operators:
         like the outer air's, Young-Laplace's below that gas pressure, floored alike."""
         if cavity is None:
             cavity = np.zeros_like(flooded)
-        factor = np.broadcast_to(self.pull_factor(flooded), flooded.shape)
+        factor = np.ascontiguousarray(np.broadcast_to(self.pull_factor(flooded), flooded.shape),
+                                      dtype=float)
         theta = 0.5 + self.fill(c, cavity) if self.sub_cell else np.ones_like(c)
-        per_axis = {}
-        for axis, g in ((1, self.gx), (0, self.gy)):
-            lo = [slice(None), slice(None)]
-            hi = [slice(None), slice(None)]
-            lo[axis], hi[axis] = slice(None, -1), slice(1, None)
-            lo, hi = tuple(lo), tuple(hi)
-            hi_open = flooded[lo] & ~flooded[hi]        # else the lo side is the open one
-            th = np.where(hi_open, theta[hi], theta[lo])
-            h_f = np.where(hi_open, self.h[lo], self.h[hi])
-            h_o = np.where(hi_open, self.h[hi], self.h[lo])
-            h_m = h_f + th * (h_o - h_f)
-            safe = np.where(h_m > 0, h_m, 1.0)          # faces on the island carry nothing
-            suction = np.where(hi_open, factor[hi], factor[lo]) * self.young_laplace / safe
-            p_m = np.where(h_m > 0, -suction, 0.0)
-            if self.p_cav is not None:
-                in_cavity = np.where(hi_open, cavity[hi], cavity[lo])
-                if gas is None:
-                    p_m = np.where(in_cavity, self.p_cav, np.maximum(p_m, self.p_cav))
-                else:
-                    p_gas = np.nan_to_num(np.where(hi_open, gas[hi], gas[lo]))
-                    p_m = np.maximum(np.where(in_cavity, p_gas + p_m, p_m), self.p_cav)
-            per_axis[axis] = (g / th, p_m, h_m)
-        (gx, px, hx), (gy, py, _) = per_axis[1], per_axis[0]
+        has_gas = gas is not None and self.p_cav is not None
+        gas = np.asarray(gas, dtype=float) if has_gas else self.h
+        p_cav = 0.0 if self.p_cav is None else float(self.p_cav)
+        gx, px, hx = meniscus_faces(flooded, theta, self.h, factor, self.young_laplace,
+                                    self.gx, cavity, gas, p_cav, self.p_cav is not None,
+                                    has_gas, 1)
+        gy, py, _ = meniscus_faces(flooded, theta, self.h, factor, self.young_laplace,
+                                   self.gy, cavity, gas, p_cav, self.p_cav is not None,
+                                   has_gas, 0)
         return _Faces(gx=gx, gy=gy, px=px, py=py, hx=hx)
 
     def pressure(self, flooded: np.ndarray, c: np.ndarray, dt: float,
                  faces: "_Faces") -> np.ndarray:
         """p on the flooded cells, the menisci at ``faces``' pressures: each flooded cell's
         outflow is what it holds beyond its gap / dt."""
-        ny, nx = flooded.shape
-        n = int(flooded.sum())
-        p = np.full((ny, nx), np.nan)
-        if n == 0:
+        p = np.full(flooded.shape, np.nan)
+        if not flooded.any():
             return p
-        idx = -np.ones((ny, nx), dtype=np.int64)
-        idx[flooded] = np.arange(n)
-        rows, cols, vals = [], [], []
-        rhs = ((c - self.h) * self.d * self.d / dt)[flooded]
-        carried = self.u * c * self.d                  # what an open cell's walls carry on
-        zeros_y = np.zeros_like(self.gy)
-        for lo, hi, g, gm, full, open_lo, pm in (
-                (idx[:, :-1], idx[:, 1:], self.gx, faces.gx, self.cx, carried[:, :-1],
-                 faces.px),
-                (idx[:-1], idx[1:], self.gy, faces.gy, zeros_y, zeros_y, faces.py)):
-            lo, hi, g, gm = lo.ravel(), hi.ravel(), g.ravel(), gm.ravel()
-            full, open_lo, pm = full.ravel(), open_lo.ravel(), pm.ravel()
-            both = (lo >= 0) & (hi >= 0) & (g > 0)
-            a, b, gg = lo[both], hi[both], g[both]
-            rows += [a, b, a, b]
-            cols += [a, b, b, a]
-            vals += [gg, gg, -gg, -gg]
-            np.add.at(rhs, a, -full[both])
-            np.add.at(rhs, b, full[both])
-            sel = (lo >= 0) & (hi < 0) & (g > 0)       # flooded lo, meniscus in hi
-            rows.append(lo[sel]), cols.append(lo[sel]), vals.append(gm[sel])
-            np.add.at(rhs, lo[sel], -full[sel] + gm[sel] * pm[sel])
-            sel = (lo < 0) & (hi >= 0) & (g > 0)       # meniscus in lo, flooded hi
-            rows.append(hi[sel]), cols.append(hi[sel]), vals.append(gm[sel])
-            np.add.at(rhs, hi[sel], open_lo[sel] + gm[sel] * pm[sel])
-        first, side, last = idx[:, 0], idx[-1], idx[:, -1]
-        np.add.at(rhs, first[first >= 0], self.q_supply[first >= 0])
-        rows.append(side[side >= 0]), cols.append(side[side >= 0])
-        vals.append(self.g_side[side >= 0])
-        rows.append(last[last >= 0]), cols.append(last[last >= 0])
-        vals.append(self.g_out[last >= 0])
-        np.add.at(rhs, last[last >= 0], -self.cx_out[last >= 0])
-        A = coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                       shape=(n, n)).tocsr()
+        data, indices, indptr, rhs = pressure_system(
+            flooded, c, self.h, self.d, dt, self.u, self.gx, self.gy, self.cx, faces.gx,
+            faces.gy, faces.px, faces.py, self.q_supply, self.g_side, self.g_out, self.cx_out)
+        n = rhs.size
+        A = csr_matrix((data, indices, indptr), shape=(n, n))
         p[flooded] = spsolve(A, rhs, permc_spec="MMD_AT_PLUS_A")
         return p
 

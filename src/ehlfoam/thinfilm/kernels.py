@@ -1,0 +1,170 @@
+"""The thin-film step's hot loops as numba kernels: the flooded cells' pressure system, the
+menisci on the faces between flooded and open cells, and the open cells connected to the
+domain's open edges. Each does what the array expressions in
+:mod:`ehlfoam.thinfilm.operators` and :mod:`ehlfoam.thinfilm.cavity` say, in one pass over
+the grid (the right-hand side in the same order of additions); a step of the medium level
+(5,000 cells) made some thirty whole-array temporaries for each of them. Arrays are indexed
+``[row, column]``: rows across the track (y), columns along the rolling direction (x)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_BIG = float(np.finfo(np.float64).max)     # np.nan_to_num's stand-in for inf
+
+
+@njit(cache=True)
+def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_supply,
+                    g_side, g_out, cx_out):
+    """The flooded cells' pressure system, numbered row by row: CSR ``(data, indices,
+    indptr)`` with sorted columns and the right-hand side [m3/s]. Faces with a positive
+    conductance (``gx``: x faces (ny, nx - 1), ``gy``: y faces (ny - 1, nx) [m3/(Pa s)])
+    join two flooded cells, or a flooded cell to the meniscus in its open neighbour
+    (conductance ``mgx`` / ``mgy``, pressure ``mpx`` / ``mpy`` [Pa]); ``cx``: the Couette
+    flux of a full x face [m3/s]; the supply into the first column, the side row's and the
+    last column's outflow conductances and the outlet's Couette flux."""
+    ny, nx = flooded.shape
+    idx = np.full((ny, nx), -1, np.int64)
+    n = 0
+    for i in range(ny):
+        for j in range(nx):
+            if flooded[i, j]:
+                idx[i, j] = n
+                n += 1
+    data = np.empty(5 * n)
+    indices = np.empty(5 * n, np.int64)
+    indptr = np.zeros(n + 1, np.int64)
+    rhs = np.empty(n)
+    k = 0
+    for i in range(ny):
+        for j in range(nx):
+            r = idx[i, j]
+            if r < 0:
+                continue
+            b = ((c[i, j] - h[i, j]) * d * d / dt)
+            diag = 0.0
+            # x faces: to the right (this cell lo), to the left (this cell hi)
+            right = j + 1 < nx and gx[i, j] > 0
+            left = j > 0 and gx[i, j - 1] > 0
+            if right and flooded[i, j + 1]:
+                b += -cx[i, j]
+            if left and flooded[i, j - 1]:
+                b += cx[i, j - 1]
+            if right and not flooded[i, j + 1]:
+                b += -cx[i, j] + mgx[i, j] * mpx[i, j]
+            if left and not flooded[i, j - 1]:
+                b += u * c[i, j - 1] * d + mgx[i, j - 1] * mpx[i, j - 1]
+            # y faces: below (this cell lo), above (this cell hi): no Couette flux
+            down = i + 1 < ny and gy[i, j] > 0
+            up = i > 0 and gy[i - 1, j] > 0
+            if down and not flooded[i + 1, j]:
+                b += mgy[i, j] * mpy[i, j]
+            if up and not flooded[i - 1, j]:
+                b += mgy[i - 1, j] * mpy[i - 1, j]
+            if j == 0:
+                b += q_supply[i]
+            if j == nx - 1:
+                b += -cx_out[i]
+            rhs[r] = b
+            # the row's entries, columns in increasing order: up, left, self, right, down
+            if up and flooded[i - 1, j]:
+                data[k], indices[k] = -gy[i - 1, j], idx[i - 1, j]
+                k += 1
+                diag += gy[i - 1, j]
+            elif up:
+                diag += mgy[i - 1, j]
+            if left and flooded[i, j - 1]:
+                data[k], indices[k] = -gx[i, j - 1], idx[i, j - 1]
+                k += 1
+                diag += gx[i, j - 1]
+            elif left:
+                diag += mgx[i, j - 1]
+            if right:
+                diag += gx[i, j] if flooded[i, j + 1] else mgx[i, j]
+            if down:
+                diag += gy[i, j] if flooded[i + 1, j] else mgy[i, j]
+            if i == ny - 1:
+                diag += g_side[j]
+            if j == nx - 1:
+                diag += g_out[i]
+            data[k], indices[k] = diag, r
+            k += 1
+            if right and flooded[i, j + 1]:
+                data[k], indices[k] = -gx[i, j], idx[i, j + 1]
+                k += 1
+            if down and flooded[i + 1, j]:
+                data[k], indices[k] = -gy[i, j], idx[i + 1, j]
+                k += 1
+            indptr[r + 1] = k
+    return data[:k], indices[:k], indptr, rhs
+
+
+@njit(cache=True)
+def meniscus_faces(flooded, theta, h, factor, young_laplace, g, cavity, gas, p_cav,
+                   has_cav, has_gas, axis):
+    """On every face along ``axis`` (1: x faces (ny, nx - 1), 0: y faces (ny - 1, nx)) the
+    flooded cell's conductance to a meniscus in its open neighbour (``g`` / theta), the
+    meniscus's pressure [Pa] and the gap there [m], as
+    :meth:`ehlfoam.thinfilm.operators.Operators.menisci` defines them (``factor``: the
+    dynamic menisci's factor on every cell; ``gas``: every cell's gas pressure, gauge [Pa],
+    NaN off the cavities, used when ``has_gas``; ``p_cav`` when ``has_cav``)."""
+    ny, nx = flooded.shape
+    fy, fx = (ny, nx - 1) if axis == 1 else (ny - 1, nx)
+    g_m = np.empty((fy, fx))
+    p_m = np.empty((fy, fx))
+    h_m = np.empty((fy, fx))
+    for i in range(fy):
+        for j in range(fx):
+            i2, j2 = (i, j + 1) if axis == 1 else (i + 1, j)
+            hi_open = flooded[i, j] and not flooded[i2, j2]
+            if hi_open:     # the flooded cell lo, the meniscus in hi
+                th, hf, ho = theta[i2, j2], h[i, j], h[i2, j2]
+                fac, in_cav, pg = factor[i2, j2], cavity[i2, j2], gas[i2, j2]
+            else:
+                th, hf, ho = theta[i, j], h[i2, j2], h[i, j]
+                fac, in_cav, pg = factor[i, j], cavity[i, j], gas[i, j]
+            hm = hf + th * (ho - hf)
+            safe = hm if hm > 0 else 1.0
+            suction = fac * young_laplace / safe
+            p = -suction if hm > 0 else 0.0
+            if has_cav:
+                if not has_gas:
+                    p = p_cav if in_cav else max(p, p_cav)
+                else:
+                    if np.isnan(pg):
+                        pg = 0.0
+                    elif np.isinf(pg):
+                        pg = _BIG if pg > 0 else -_BIG
+                    p = max(pg + p if in_cav else p, p_cav)
+            g_m[i, j] = g[i, j] / th
+            p_m[i, j] = p
+            h_m[i, j] = hm
+    return g_m, p_m, h_m
+
+
+@njit(cache=True)
+def edge_connected(gas, closed_side):
+    """The cells of ``gas`` (bool, ny x nx) connected through other gas cells (4-neighbours)
+    to the first and last columns and, unless ``closed_side``, the last row."""
+    ny, nx = gas.shape
+    out = np.zeros((ny, nx), np.bool_)
+    stack = np.empty(ny * nx, np.int64)
+    top = 0
+    for i in range(ny):
+        for j in range(nx):
+            edge = j == 0 or j == nx - 1 or (i == ny - 1 and not closed_side)
+            if edge and gas[i, j] and not out[i, j]:
+                out[i, j] = True
+                stack[top] = i * nx + j
+                top += 1
+    while top > 0:
+        top -= 1
+        i, j = divmod(stack[top], nx)
+        for di, dj in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+            a, b = i + di, j + dj
+            if 0 <= a < ny and 0 <= b < nx and gas[a, b] and not out[a, b]:
+                out[a, b] = True
+                stack[top] = a * nx + b
+                top += 1
+    return out
