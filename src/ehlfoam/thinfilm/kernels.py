@@ -168,3 +168,24 @@ def edge_connected(gas, closed_side):
                 stack[top] = a * nx + b
                 top += 1
     return out
+
+
+@njit(cache=True)
+def upper_band(data, indices, indptr, max_band):
+    """The symmetric CSR matrix ``(data, indices, indptr)`` in LAPACK's upper band storage,
+    ``ab[band + i - j, j] = A[i, j]`` for j >= i, or an empty array when its half-bandwidth
+    exceeds ``max_band`` (row-major numbering gives the flooded region's width in cells)."""
+    n = indptr.size - 1
+    band = 0
+    for i in range(n):
+        for k in range(indptr[i], indptr[i + 1]):
+            band = max(band, indices[k] - i)
+    if band > max_band:
+        return np.empty((0, 0))
+    ab = np.zeros((band + 1, n))
+    for i in range(n):
+        for k in range(indptr[i], indptr[i + 1]):
+            j = indices[k]
+            if j >= i:
+                ab[band + i - j, j] = data[k]
+    return ab

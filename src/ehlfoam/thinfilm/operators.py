@@ -10,11 +10,12 @@ from typing import NamedTuple
 
 import numpy as np
 from scipy import ndimage
+from scipy.linalg.lapack import dpbsv
 from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
 from ehlfoam.thinfilm.cavity import cavities
-from ehlfoam.thinfilm.kernels import meniscus_faces, pressure_system
+from ehlfoam.thinfilm.kernels import meniscus_faces, pressure_system, upper_band
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
@@ -142,9 +143,7 @@ class Operators:
         data, indices, indptr, rhs = pressure_system(
             flooded, c, self.h, self.d, dt, self.u, self.gx, self.gy, self.cx, faces.gx,
             faces.gy, faces.px, faces.py, self.q_supply, self.g_side, self.g_out, self.cx_out)
-        n = rhs.size
-        A = csr_matrix((data, indices, indptr), shape=(n, n))
-        p[flooded] = spsolve(A, rhs, permc_spec="MMD_AT_PLUS_A")
+        p[flooded] = _solve(data, indices, indptr, rhs)
         return p
 
     def step(self, flooded: np.ndarray, c: np.ndarray, dt: float,
@@ -275,6 +274,25 @@ class _Faces(NamedTuple):
     px: np.ndarray
     py: np.ndarray
     hx: np.ndarray    # the gap at the meniscus on x faces [m]: a receding one lays f of it
+
+
+#: the widest band (cells) solved as a band; sparse LU beyond, where the band's n b^2 loses
+MAX_BAND = 64
+
+
+def _solve(data: np.ndarray, indices: np.ndarray, indptr: np.ndarray,
+           rhs: np.ndarray) -> np.ndarray:
+    """The flooded cells' pressure from their symmetric positive definite system (CSR):
+    banded Cholesky (LAPACK pbsv; twice as fast as sparse LU on a region a few tens of
+    cells wide), sparse LU where the band is wider or the matrix not positive definite."""
+    ab = upper_band(data, indices, indptr, MAX_BAND)
+    if ab.size:
+        _, x, info = dpbsv(ab, rhs, lower=0, overwrite_ab=1)
+        if info == 0:
+            return x
+    n = rhs.size
+    return spsolve(csr_matrix((data, indices, indptr), shape=(n, n)), rhs,
+                   permc_spec="MMD_AT_PLUS_A")
 
 
 def _face_flux(f_lo, f_hi, p_lo, p_hi, g, g_m, p_m):
