@@ -262,6 +262,8 @@ def advance(m: Marcher, steps: int = 1) -> None:
     longer finite (with :data:`MARCH_ERRORS`, what a failing march raises)."""
     for _ in range(steps):
         m.step()
+        if _CAUGHT:
+            raise KeyboardInterrupt
     if not np.isfinite(m.c).all():
         raise FloatingPointError("the oil content is no longer finite")
 
@@ -283,15 +285,30 @@ def swapped_handlers(signals: tuple[int, ...], handler: Callable) -> Iterator[bo
             signal.signal(sig, previous)
 
 
+#: SIGTERM / SIGINT caught within :func:`sigterm_interrupts`, not yet acted on
+_CAUGHT: list[int] = []
+
+
 @contextmanager
 def sigterm_interrupts() -> Iterator[None]:
-    """Within the block SIGTERM raises KeyboardInterrupt (the run ends ``interrupted``, its
-    state written); the handler before is put back after it. Nothing changes where signals
-    cannot be set (not the main thread)."""
-    def interrupt(signum: int, frame: object) -> None:
+    """Within the block SIGTERM and SIGINT interrupt the march between two steps:
+    :func:`advance` raises KeyboardInterrupt after the step it was in (the run ends
+    ``interrupted``, its state written whole), or the block's end does when no step came
+    after. Raised the moment the signal came, the interrupt could land inside a step, or in
+    a numba kernel's return, where it became a SystemError (an internal error). The
+    handlers before are put back after the block; nothing changes where signals cannot be
+    set (not the main thread)."""
+    def note(signum: int, frame: object) -> None:
+        _CAUGHT.append(signum)
+    _CAUGHT.clear()
+    with swapped_handlers((signal.SIGTERM, signal.SIGINT), note):
+        try:
+            yield
+        finally:
+            caught = bool(_CAUGHT)
+            _CAUGHT.clear()
+    if caught:
         raise KeyboardInterrupt
-    with swapped_handlers((signal.SIGTERM,), interrupt):
-        yield
 
 
 class _Log:
