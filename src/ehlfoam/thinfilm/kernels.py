@@ -171,21 +171,158 @@ def edge_connected(gas, closed_side):
 
 
 @njit(cache=True)
-def upper_band(data, indices, indptr, max_band):
-    """The symmetric CSR matrix ``(data, indices, indptr)`` in LAPACK's upper band storage,
-    ``ab[band + i - j, j] = A[i, j]`` for j >= i, or an empty array when its half-bandwidth
-    exceeds ``max_band`` (row-major numbering gives the flooded region's width in cells)."""
-    n = indptr.size - 1
+def band_cholesky_solve(data, indices, indptr, rhs, max_band):
+    """x of A x = rhs for the symmetric positive definite CSR matrix ``(data, indices,
+    indptr)`` by a banded Cholesky factorisation L L^T (row by row, the band of L stored a
+    row at a time, each row from its first entry in A on), and True; or an empty x and False when its half-bandwidth exceeds
+    ``max_band`` or a pivot is not positive. Row-major numbering makes the band the flooded
+    region's width in cells. Single-threaded by design: LAPACK's banded Cholesky through a
+    threaded BLAS spent tens of times the CPU on these few hundred unknowns on a busy
+    machine."""
+    n = rhs.size
     band = 0
     for i in range(n):
         for k in range(indptr[i], indptr[i + 1]):
-            band = max(band, indices[k] - i)
+            band = max(band, i - indices[k])
     if band > max_band:
-        return np.empty((0, 0))
-    ab = np.zeros((band + 1, n))
+        return np.empty(0), False
+    low = np.zeros((n, band + 1))     # low[i, band + k - i] = L[i, k], k in i - band .. i
     for i in range(n):
         for k in range(indptr[i], indptr[i + 1]):
             j = indices[k]
-            if j >= i:
-                ab[band + i - j, j] = data[k]
-    return ab
+            if j <= i:
+                low[i, band + j - i] = data[k]
+    first = np.empty(n, np.int64)     # L's rows start where A's do (its profile)
+    for i in range(n):
+        first[i] = min(indices[indptr[i]:indptr[i + 1]].min(), i) if indptr[i + 1] > indptr[i] \
+            else i
+    for i in range(n):
+        for j in range(first[i], i + 1):
+            s = low[i, band + j - i]
+            for k in range(max(first[i], first[j]), j):
+                s -= low[i, band + k - i] * low[j, band + k - j]
+            if j < i:
+                low[i, band + j - i] = s / low[j, band]
+            elif s > 0.0:
+                low[i, band] = np.sqrt(s)
+            else:
+                return np.empty(0), False
+    x = rhs.copy()
+    for i in range(n):                # L y = rhs
+        s = x[i]
+        for k in range(first[i], i):
+            s -= low[i, band + k - i] * x[k]
+        x[i] = s / low[i, band]
+    for i in range(n - 1, -1, -1):    # L^T x = y
+        s = x[i]
+        for k in range(i + 1, min(n, i + band + 1)):
+            s -= low[k, band + i - k] * x[k]
+        x[i] = s / low[i, band]
+    return x, True
+
+
+@njit(cache=True)
+def net_inflow(qx, qy, q_last, q_side, q_supply):
+    """Net inflow of every cell [m3/s] from the face fluxes (lo -> hi: x faces (ny, nx - 1),
+    y faces (ny - 1, nx)), the supply into the first column and the outflow through the last
+    column and the side row."""
+    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
+    net = np.zeros((ny, nx))
+    for i in range(ny):
+        for j in range(nx):
+            v = net[i, j]
+            if j < nx - 1:
+                v -= qx[i, j]
+            if j > 0:
+                v += qx[i, j - 1]
+            if i < ny - 1:
+                v -= qy[i, j]
+            if i > 0:
+                v += qy[i - 1, j]
+            if j == 0:
+                v += q_supply[i]
+            if j == nx - 1:
+                v -= q_last[i]
+            if i == ny - 1:
+                v -= q_side[j]
+            net[i, j] = v
+    return net
+
+
+@njit(cache=True)
+def _given(qx, qy, q_last, q_side, mx, my, outer):
+    """What every cell gives up [m3/s]: its outgoing fluxes on the faces ``mx`` / ``my``
+    mark, and through the outlet and the side when ``outer``."""
+    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
+    out = np.zeros((ny, nx))
+    for i in range(ny):
+        for j in range(nx):
+            v = out[i, j]
+            if j < nx - 1 and mx[i, j]:
+                v += max(qx[i, j], 0.0)
+            if j > 0 and mx[i, j - 1]:
+                v += max(-qx[i, j - 1], 0.0)
+            if i < ny - 1 and my[i, j]:
+                v += max(qy[i, j], 0.0)
+            if i > 0 and my[i - 1, j]:
+                v += max(-qy[i - 1, j], 0.0)
+            if outer and j == nx - 1:
+                v += max(q_last[i], 0.0)
+            if outer and i == ny - 1:
+                v += max(q_side[j], 0.0)
+            out[i, j] = v
+    return out
+
+
+@njit(cache=True)
+def hold_back(qx, qy, q_last, q_side, q_supply, held, opn, draw_x, draw_y, layer, short_at):
+    """Cut back the fluxes out of open cells (``opn``) that would give more than they hold
+    (``held`` [m3/s] over the step; short below ``short_at``): first on the faces where the
+    flooded region draws on them (``draw_x`` / ``draw_y``), then, after the films the cells
+    behind a receding meniscus (``layer``) lay are drawn from the cell before them, on every
+    face and through the outlet and the side. Each round scales every short cell's outgoing
+    fluxes by what it can give, at most 100 rounds a pass. Returns the new qx, qy, q_last,
+    q_side (:meth:`ehlfoam.thinfilm.operators.Operators.move`)."""
+    qx, qy = qx.copy(), qy.copy()
+    q_last, q_side = q_last.copy(), q_side.copy()
+    ny, nx = held.shape
+    all_x = np.ones(qx.shape, np.bool_)
+    all_y = np.ones(qy.shape, np.bool_)
+    for only_draws in (True, False):
+        mx = draw_x if only_draws else all_x
+        my = draw_y if only_draws else all_y
+        if not only_draws:
+            net = net_inflow(qx, qy, q_last, q_side, q_supply)
+            for i in range(ny):
+                for j in range(1, nx):
+                    if layer[i, j] and opn[i, j]:
+                        qx[i, j - 1] += max(-(held[i, j] + net[i, j]), 0.0)
+        for _ in range(100):
+            net = net_inflow(qx, qy, q_last, q_side, q_supply)
+            short = opn & (held + net < short_at)
+            if not short.any():
+                break
+            give = _given(qx, qy, q_last, q_side, mx, my, not only_draws)
+            short = short & (give > 0)
+            if not short.any():
+                break
+            scale = np.ones((ny, nx))
+            for i in range(ny):
+                for j in range(nx):
+                    if short[i, j]:
+                        room = (held[i, j] + net[i, j] + give[i, j]) / give[i, j]
+                        scale[i, j] = min(max(room, 0.0), 1.0 - 1e-12)
+            for i in range(ny):
+                for j in range(nx - 1):
+                    if mx[i, j]:
+                        qx[i, j] *= scale[i, j] if qx[i, j] > 0 else scale[i, j + 1]
+            for i in range(ny - 1):
+                for j in range(nx):
+                    if my[i, j]:
+                        qy[i, j] *= scale[i, j] if qy[i, j] > 0 else scale[i + 1, j]
+            if not only_draws:
+                for i in range(ny):
+                    q_last[i] *= scale[i, nx - 1]
+                for j in range(nx):
+                    q_side[j] *= scale[ny - 1, j]
+    return qx, qy, q_last, q_side

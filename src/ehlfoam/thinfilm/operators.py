@@ -10,12 +10,12 @@ from typing import NamedTuple
 
 import numpy as np
 from scipy import ndimage
-from scipy.linalg.lapack import dpbsv
 from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
 from ehlfoam.thinfilm.cavity import cavities
-from ehlfoam.thinfilm.kernels import meniscus_faces, pressure_system, upper_band
+from ehlfoam.thinfilm.kernels import (band_cholesky_solve, hold_back, meniscus_faces, net_inflow,
+                                      pressure_system)
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
@@ -215,33 +215,10 @@ class Operators:
                   | (flooded[:-1] & ~flooded[1:] & (qy < 0)))
         layer = np.zeros_like(flooded)                 # the cells behind a receding meniscus
         layer[:, 1:-1] = lays
-        for only_draws in (True, False):
-            if not only_draws:                         # films are laid from the region's oil
-                net = _net(qx, qy, q_last, q_side, self.q_supply)
-                deficit = np.where(layer & opn, np.clip(-(held + net), 0.0, None), 0.0)
-                qx += deficit[:, 1:]
-            for _ in range(100):
-                net = _net(qx, qy, q_last, q_side, self.q_supply)
-                short = opn & (held + net < -1e-12 * self.h * d * d / dt)
-                if not short.any():
-                    break
-                mx = draw_x if only_draws else np.ones_like(draw_x)
-                my = draw_y if only_draws else np.ones_like(draw_y)
-                give = _given(qx * mx, qy * my, 0 * q_last if only_draws else q_last,
-                              0 * q_side if only_draws else q_side)
-                short &= give > 0
-                if not short.any():
-                    break
-                room = (held + net + give) / np.where(short, give, 1.0)
-                scale = np.where(short, np.clip(room, 0.0, 1.0 - 1e-12), 1.0)
-                sx = np.where(qx > 0, scale[:, :-1], scale[:, 1:])
-                sy = np.where(qy > 0, scale[:-1], scale[1:])
-                qx = np.where(mx, qx * sx, qx)
-                qy = np.where(my, qy * sy, qy)
-                if not only_draws:
-                    q_last = q_last * scale[:, -1]
-                    q_side = q_side * scale[-1]
-        net = _net(qx, qy, q_last, q_side, self.q_supply)
+        qx, qy, q_last, q_side = hold_back(
+            qx, qy, np.asarray(q_last, dtype=float), np.asarray(q_side, dtype=float),
+            self.q_supply, held, opn, draw_x, draw_y, layer, -1e-12 * self.h * d * d / dt)
+        net = net_inflow(qx, qy, q_last, q_side, self.q_supply)
         out = net * dt / (d * d), float(q_last.sum()), float(q_side.sum())
         return (*out, q_last) if by_row else out
 
@@ -282,14 +259,12 @@ MAX_BAND = 64
 
 def _solve(data: np.ndarray, indices: np.ndarray, indptr: np.ndarray,
            rhs: np.ndarray) -> np.ndarray:
-    """The flooded cells' pressure from their symmetric positive definite system (CSR):
-    banded Cholesky (LAPACK pbsv; twice as fast as sparse LU on a region a few tens of
-    cells wide), sparse LU where the band is wider or the matrix not positive definite."""
-    ab = upper_band(data, indices, indptr, MAX_BAND)
-    if ab.size:
-        _, x, info = dpbsv(ab, rhs, lower=0, overwrite_ab=1)
-        if info == 0:
-            return x
+    """The flooded cells' pressure from their symmetric positive definite system (CSR): a
+    banded Cholesky factorisation (twice as fast as sparse LU on a region a few tens of
+    cells wide), sparse LU where the band is wider or a pivot not positive."""
+    x, ok = band_cholesky_solve(data, indices, indptr, rhs, MAX_BAND)
+    if ok:
+        return x
     n = rhs.size
     return spsolve(csr_matrix((data, indices, indptr), shape=(n, n)), rhs,
                    permc_spec="MMD_AT_PLUS_A")
@@ -302,34 +277,6 @@ def _face_flux(f_lo, f_hi, p_lo, p_hi, g, g_m, p_m):
     return np.where(f_lo & f_hi, g * (p_lo - p_hi),
                     np.where(f_lo & ~f_hi, g_m * (p_lo - p_m),
                              np.where(~f_lo & f_hi, g_m * (p_m - p_hi), 0.0)))
-
-
-def _net(qx, qy, q_last, q_side, q_supply):
-    """Net inflow of every cell [m3/s] from the face fluxes (lo -> hi), the supply into the
-    first column and the outflow through the last one and the side."""
-    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
-    net = np.zeros((ny, nx))
-    net[:, :-1] -= qx
-    net[:, 1:] += qx
-    net[:-1] -= qy
-    net[1:] += qy
-    net[:, 0] += q_supply
-    net[:, -1] -= q_last
-    net[-1] -= q_side
-    return net
-
-
-def _given(qx, qy, q_last, q_side):
-    """What every cell gives up [m3/s]: its outgoing face fluxes."""
-    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
-    out = np.zeros((ny, nx))
-    out[:, :-1] += np.clip(qx, 0, None)
-    out[:, 1:] += np.clip(-qx, 0, None)
-    out[:-1] += np.clip(qy, 0, None)
-    out[1:] += np.clip(-qy, 0, None)
-    out[:, -1] += np.clip(q_last, 0, None)
-    out[-1] += np.clip(q_side, 0, None)
-    return out
 
 
 def touches(flooded: np.ndarray) -> np.ndarray:
