@@ -16,14 +16,17 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ehlfoam.cli.main import main
 from ehlfoam.cli.run import KEYS
 from ehlfoam.run.fields import Sample
+from ehlfoam.run.thin_film import advance, sigterm_interrupts
 from ehlfoam.thinfilm.state import load_state
 from tests.tiny import THIN_FILM
 
@@ -206,6 +209,51 @@ def test_sigterm_ends_the_run_interrupted_with_its_state_written(ran, tmp_path):
     m = metrics(case)
     assert (m["status"], m["end_reason"]) == ("interrupted", "interrupted")
     assert load_state(case / "state.npz").time == pytest.approx(m["simulated_time_s"])
+
+
+class _SignallingMarch:
+    """A march whose second step sends this process ``sig`` halfway through."""
+
+    c = np.zeros(3)
+
+    def __init__(self, sig: int):
+        self.sig, self.started, self.done = sig, 0, 0
+
+    def step(self) -> None:
+        self.started += 1
+        if self.started == 2:
+            os.kill(os.getpid(), self.sig)
+        sum(range(1000))                 # bytecodes on which a raising handler would run
+        self.done += 1
+
+
+main_thread_only = pytest.mark.skipif(threading.current_thread() is not threading.main_thread(),
+                                      reason="signal handlers are set in the main thread")
+
+
+@main_thread_only
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_interrupts_the_march_after_the_step_it_came_in(sig):
+    before = signal.getsignal(sig)
+    m = _SignallingMarch(sig)
+    with pytest.raises(KeyboardInterrupt):
+        with sigterm_interrupts():
+            advance(m, 5)
+    assert (m.started, m.done) == (2, 2)        # the step it came in was done whole
+    assert signal.getsignal(sig) is before
+
+
+@main_thread_only
+def test_a_signal_after_the_last_step_interrupts_at_the_blocks_end():
+    m = _SignallingMarch(signal.SIGTERM)
+    with pytest.raises(KeyboardInterrupt):
+        with sigterm_interrupts():
+            advance(m, 1)
+            m.started = 1
+            m.step()                            # not through advance: nothing checks
+            assert m.done == 2
+    with sigterm_interrupts():                  # the next block starts with none caught
+        advance(m, 1)
 
 
 def test_a_thin_film_case_starts_from_another_ones_state_and_not_from_a_3d_case(ran, tmp_path,

@@ -1,0 +1,87 @@
+"""The thin-film step's numba kernels: the banded Cholesky solve against sparse LU, its
+refusals, and the pressure solve the same whichever of the two it takes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.sparse import csr_matrix
+from scipy.sparse.linalg import spsolve
+
+from ehlfoam.thinfilm import Grid, ThinFilmProblem
+from ehlfoam.thinfilm import operators
+from ehlfoam.thinfilm.kernels import band_cholesky_solve
+
+A = 1.4e-4     # m: a contact radius's order
+
+
+def five_point(mask: np.ndarray, rng: np.random.Generator) -> csr_matrix:
+    """A conductance matrix on the ``mask``'s cells, numbered row by row: random positive
+    conductances between 4-neighbours, and some cells tied to a fixed pressure (the
+    menisci's), as the flooded region's system is."""
+    ny, nx = mask.shape
+    idx = -np.ones(mask.shape, dtype=np.int64)
+    idx[mask] = np.arange(mask.sum())
+    n = int(mask.sum())
+    dense = np.zeros((n, n))
+    for i in range(ny):
+        for j in range(nx):
+            if not mask[i, j]:
+                continue
+            a = idx[i, j]
+            for di, dj in ((0, 1), (1, 0)):
+                if i + di < ny and j + dj < nx and mask[i + di, j + dj]:
+                    b, g = idx[i + di, j + dj], rng.uniform(0.1, 10.0)
+                    dense[a, a] += g
+                    dense[b, b] += g
+                    dense[a, b] -= g
+                    dense[b, a] -= g
+            if i == 0 or j == 0 or rng.uniform() < 0.05:
+                dense[a, a] += rng.uniform(0.1, 1.0)
+    return csr_matrix(dense)
+
+
+def test_the_banded_cholesky_solve_is_sparse_lus():
+    rng = np.random.default_rng(7)
+    yy, xx = np.mgrid[0:24, 0:40]
+    mask = np.hypot((xx - 18) / 18, yy / 20) < 1.0          # a half region, ragged rows
+    mat = five_point(mask, rng)
+    rhs = rng.normal(size=mat.shape[0])
+    x, ok = band_cholesky_solve(mat.data, mat.indices.astype(np.int64),
+                                mat.indptr.astype(np.int64), rhs, 64)
+    assert ok
+    exact = spsolve(mat, rhs)
+    assert np.max(np.abs(x - exact)) <= 1e-10 * np.max(np.abs(exact))
+
+
+def test_the_banded_solve_refuses_a_wide_band_and_a_matrix_not_positive_definite():
+    rng = np.random.default_rng(3)
+    mat = five_point(np.ones((10, 30), dtype=bool), rng)   # a band of 30
+    args = (mat.data, mat.indices.astype(np.int64), mat.indptr.astype(np.int64),
+            np.ones(mat.shape[0]))
+    assert band_cholesky_solve(*args, 29)[1] is False
+    assert band_cholesky_solve(*args, 30)[1] is True
+    assert band_cholesky_solve(-mat.data, *args[1:], 64)[1] is False
+
+
+def test_the_pressure_is_the_same_by_band_or_by_sparse_lu(monkeypatch):
+    """A round region on a ball's gap: its pressure solved as a band (about 30 cells wide)
+    and, with the band refused, by sparse LU."""
+    prob = ThinFilmProblem(gap=lambda x, y: 1e-6 + (x**2 + y**2) / (2 * 0.01), speed=0.01,
+                           viscosity=0.02, surface_tension=0.03, contact_angle=15.0,
+                           supply=2e-6, track_half_width=3e-4, x_range=(-8 * A, 10 * A),
+                           y_max=8 * A, island_radius=A, cell=0.2 * A, initial_radius=6 * A)
+    grid = Grid.build(prob)
+    ops = operators.Operators(prob, grid)
+    X, Y = np.meshgrid(grid.x, grid.y)
+    flooded = (np.hypot(X, Y) < 6 * A) & ~grid.island
+    c = np.where(flooded, ops.h, 0.3 * ops.h)
+    faces = ops.menisci(flooded, c)
+    dt = 0.25 * grid.cell / prob.speed
+    banded = ops.pressure(flooded, c, dt, faces)
+    monkeypatch.setattr(operators, "MAX_BAND", 0)
+    by_lu = ops.pressure(flooded, c, dt, faces)
+    assert np.isfinite(banded[flooded]).all() and np.isnan(banded[~flooded]).all()
+    scale = np.max(np.abs(by_lu[flooded]))
+    assert scale > 0
+    assert np.max(np.abs(banded[flooded] - by_lu[flooded])) <= 1e-12 * scale
