@@ -4,7 +4,6 @@ refusals, and the pressure solve the same whichever of the two it takes."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 

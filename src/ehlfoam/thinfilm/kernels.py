@@ -1,10 +1,12 @@
-"""The thin-film step's hot loops as numba kernels: the flooded cells' pressure system, the
-menisci on the faces between flooded and open cells, and the open cells connected to the
-domain's open edges. Each does what the array expressions in
-:mod:`ehlfoam.thinfilm.operators` and :mod:`ehlfoam.thinfilm.cavity` say, in one pass over
-the grid (the right-hand side in the same order of additions); a step of the medium level
-(5,000 cells) made some thirty whole-array temporaries for each of them. Arrays are indexed
-``[row, column]``: rows across the track (y), columns along the rolling direction (x)."""
+"""The thin-film step's hot loops as numba kernels: the flooded cells' pressure system and
+its banded Cholesky solve, the menisci on the faces between flooded and open cells, the open
+cells connected to the domain's open edges, and the rounds that hold an open cell's outflow
+to what it holds. Each does what the array expressions it replaced did
+(:mod:`ehlfoam.thinfilm.operators`, :mod:`ehlfoam.thinfilm.cavity`), in one pass over the
+grid and in the same order of additions: bitwise the same but for the pressure solve. A step
+of the medium level (5,000 cells) made some thirty whole-array temporaries for each of them.
+Arrays are indexed ``[row, column]``: rows across the track (y), columns along the rolling
+direction (x)."""
 
 from __future__ import annotations
 
@@ -174,8 +176,8 @@ def edge_connected(gas, closed_side):
 def band_cholesky_solve(data, indices, indptr, rhs, max_band):
     """x of A x = rhs for the symmetric positive definite CSR matrix ``(data, indices,
     indptr)`` by a banded Cholesky factorisation L L^T (row by row, the band of L stored a
-    row at a time, each row from its first entry in A on), and True; or an empty x and False when its half-bandwidth exceeds
-    ``max_band`` or a pivot is not positive. Row-major numbering makes the band the flooded
+    row at a time, each row from its first entry in A on), and True; or an empty x and
+    False when its half-bandwidth exceeds ``max_band`` or a pivot is not positive. Row-major numbering makes the band the flooded
     region's width in cells. Single-threaded by design: LAPACK's banded Cholesky through a
     threaded BLAS spent tens of times the CPU on these few hundred unknowns on a busy
     machine."""
