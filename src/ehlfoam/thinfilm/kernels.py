@@ -17,89 +17,124 @@ _BIG = float(np.finfo(np.float64).max)     # np.nan_to_num's stand-in for inf
 
 
 @njit(cache=True)
-def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_supply,
-                    g_side, g_out, cx_out):
-    """The flooded cells' pressure system, numbered row by row: CSR ``(data, indices,
-    indptr)`` with sorted columns and the right-hand side [m3/s]. Faces with a positive
-    conductance (``gx``: x faces (ny, nx - 1), ``gy``: y faces (ny - 1, nx) [m3/(Pa s)])
-    join two flooded cells, or a flooded cell to the meniscus in its open neighbour
-    (conductance ``mgx`` / ``mgy``, pressure ``mpx`` / ``mpy`` [Pa]); ``cx``: the Couette
-    flux of a full x face [m3/s]; the supply into the first column, the side row's and the
-    last column's outflow conductances and the outlet's Couette flux."""
+def _numbering(flooded, by_column):
+    """The flooded cells' numbers, row by row (x fastest) or column by column (y fastest),
+    -1 elsewhere, and the half-bandwidth that numbering gives the system (the largest
+    difference between 4-neighbours' numbers)."""
     ny, nx = flooded.shape
     idx = np.full((ny, nx), -1, np.int64)
     n = 0
+    for k in range(ny * nx):
+        i, j = (k % ny, k // ny) if by_column else (k // nx, k % nx)
+        if flooded[i, j]:
+            idx[i, j] = n
+            n += 1
+    band = 0
     for i in range(ny):
         for j in range(nx):
-            if flooded[i, j]:
-                idx[i, j] = n
-                n += 1
+            if idx[i, j] >= 0 and i + 1 < ny and idx[i + 1, j] >= 0:
+                band = max(band, idx[i + 1, j] - idx[i, j])
+            if idx[i, j] >= 0 and j + 1 < nx and idx[i, j + 1] >= 0:
+                band = max(band, idx[i, j + 1] - idx[i, j])
+    return idx, n, band
+
+
+@njit(cache=True)
+def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_supply,
+                    g_side, g_out, cx_out):
+    """The flooded cells' pressure system: CSR ``(data, indices, indptr)`` with sorted
+    columns, the right-hand side [m3/s], and whether the cells are numbered column by
+    column (y fastest) rather than row by row, whichever gives the narrower band (a region
+    longer than it is wide: by column). Faces with a positive conductance (``gx``: x faces
+    (ny, nx - 1), ``gy``: y faces (ny - 1, nx) [m3/(Pa s)]) join two flooded cells, or a
+    flooded cell to the meniscus in its open neighbour (conductance ``mgx`` / ``mgy``,
+    pressure ``mpx`` / ``mpy`` [Pa]); ``cx``: the Couette flux of a full x face [m3/s];
+    the supply into the first column, the side row's and the last column's outflow
+    conductances and the outlet's Couette flux."""
+    ny, nx = flooded.shape
+    idx, n, band_rows = _numbering(flooded, False)
+    idx_c, _, band_columns = _numbering(flooded, True)
+    by_column = band_columns < band_rows
+    if by_column:
+        idx = idx_c
     data = np.empty(5 * n)
     indices = np.empty(5 * n, np.int64)
     indptr = np.zeros(n + 1, np.int64)
     rhs = np.empty(n)
+    row_cols = np.empty(5, np.int64)
+    row_vals = np.empty(5)
     k = 0
-    for i in range(ny):
-        for j in range(nx):
-            r = idx[i, j]
-            if r < 0:
-                continue
-            b = ((c[i, j] - h[i, j]) * d * d / dt)
-            diag = 0.0
-            # x faces: to the right (this cell lo), to the left (this cell hi)
-            right = j + 1 < nx and gx[i, j] > 0
-            left = j > 0 and gx[i, j - 1] > 0
-            if right and flooded[i, j + 1]:
-                b += -cx[i, j]
-            if left and flooded[i, j - 1]:
-                b += cx[i, j - 1]
-            if right and not flooded[i, j + 1]:
-                b += -cx[i, j] + mgx[i, j] * mpx[i, j]
-            if left and not flooded[i, j - 1]:
-                b += u * c[i, j - 1] * d + mgx[i, j - 1] * mpx[i, j - 1]
-            # y faces: below (this cell lo), above (this cell hi): no Couette flux
-            down = i + 1 < ny and gy[i, j] > 0
-            up = i > 0 and gy[i - 1, j] > 0
-            if down and not flooded[i + 1, j]:
-                b += mgy[i, j] * mpy[i, j]
-            if up and not flooded[i - 1, j]:
-                b += mgy[i - 1, j] * mpy[i - 1, j]
-            if j == 0:
-                b += q_supply[i]
-            if j == nx - 1:
-                b += -cx_out[i]
-            rhs[r] = b
-            # the row's entries, columns in increasing order: up, left, self, right, down
-            if up and flooded[i - 1, j]:
-                data[k], indices[k] = -gy[i - 1, j], idx[i - 1, j]
-                k += 1
-                diag += gy[i - 1, j]
-            elif up:
-                diag += mgy[i - 1, j]
-            if left and flooded[i, j - 1]:
-                data[k], indices[k] = -gx[i, j - 1], idx[i, j - 1]
-                k += 1
-                diag += gx[i, j - 1]
-            elif left:
-                diag += mgx[i, j - 1]
-            if right:
-                diag += gx[i, j] if flooded[i, j + 1] else mgx[i, j]
-            if down:
-                diag += gy[i, j] if flooded[i + 1, j] else mgy[i, j]
-            if i == ny - 1:
-                diag += g_side[j]
-            if j == nx - 1:
-                diag += g_out[i]
-            data[k], indices[k] = diag, r
+    for m in range(ny * nx):
+        i, j = (m % ny, m // ny) if by_column else (m // nx, m % nx)
+        r = idx[i, j]
+        if r < 0:
+            continue
+        b = ((c[i, j] - h[i, j]) * d * d / dt)
+        # x faces: to the right (this cell lo), to the left (this cell hi)
+        right = j + 1 < nx and gx[i, j] > 0
+        left = j > 0 and gx[i, j - 1] > 0
+        if right and flooded[i, j + 1]:
+            b += -cx[i, j]
+        if left and flooded[i, j - 1]:
+            b += cx[i, j - 1]
+        if right and not flooded[i, j + 1]:
+            b += -cx[i, j] + mgx[i, j] * mpx[i, j]
+        if left and not flooded[i, j - 1]:
+            b += u * c[i, j - 1] * d + mgx[i, j - 1] * mpx[i, j - 1]
+        # y faces: below (this cell lo), above (this cell hi): no Couette flux
+        down = i + 1 < ny and gy[i, j] > 0
+        up = i > 0 and gy[i - 1, j] > 0
+        if down and not flooded[i + 1, j]:
+            b += mgy[i, j] * mpy[i, j]
+        if up and not flooded[i - 1, j]:
+            b += mgy[i - 1, j] * mpy[i - 1, j]
+        if j == 0:
+            b += q_supply[i]
+        if j == nx - 1:
+            b += -cx_out[i]
+        rhs[r] = b
+        # the row's entries: its flooded neighbours, then the diagonal
+        e = 0
+        diag = 0.0
+        if up and flooded[i - 1, j]:
+            row_cols[e], row_vals[e] = idx[i - 1, j], -gy[i - 1, j]
+            e += 1
+            diag += gy[i - 1, j]
+        elif up:
+            diag += mgy[i - 1, j]
+        if left and flooded[i, j - 1]:
+            row_cols[e], row_vals[e] = idx[i, j - 1], -gx[i, j - 1]
+            e += 1
+            diag += gx[i, j - 1]
+        elif left:
+            diag += mgx[i, j - 1]
+        if right:
+            diag += gx[i, j] if flooded[i, j + 1] else mgx[i, j]
+        if down:
+            diag += gy[i, j] if flooded[i + 1, j] else mgy[i, j]
+        if i == ny - 1:
+            diag += g_side[j]
+        if j == nx - 1:
+            diag += g_out[i]
+        if right and flooded[i, j + 1]:
+            row_cols[e], row_vals[e] = idx[i, j + 1], -gx[i, j]
+            e += 1
+        if down and flooded[i + 1, j]:
+            row_cols[e], row_vals[e] = idx[i + 1, j], -gy[i, j]
+            e += 1
+        row_cols[e], row_vals[e] = r, diag
+        e += 1
+        for t in range(1, e):               # five at most: insertion sort by column
+            col, val, q = row_cols[t], row_vals[t], t
+            while q > 0 and row_cols[q - 1] > col:
+                row_cols[q], row_vals[q] = row_cols[q - 1], row_vals[q - 1]
+                q -= 1
+            row_cols[q], row_vals[q] = col, val
+        for t in range(e):
+            data[k], indices[k] = row_vals[t], row_cols[t]
             k += 1
-            if right and flooded[i, j + 1]:
-                data[k], indices[k] = -gx[i, j], idx[i, j + 1]
-                k += 1
-            if down and flooded[i + 1, j]:
-                data[k], indices[k] = -gy[i, j], idx[i + 1, j]
-                k += 1
-            indptr[r + 1] = k
-    return data[:k], indices[:k], indptr, rhs
+        indptr[r + 1] = k
+    return data[:k], indices[:k], indptr, rhs, by_column
 
 
 @njit(cache=True)
@@ -177,10 +212,10 @@ def band_cholesky_solve(data, indices, indptr, rhs, max_band):
     """x of A x = rhs for the symmetric positive definite CSR matrix ``(data, indices,
     indptr)`` by a banded Cholesky factorisation L L^T (row by row, the band of L stored a
     row at a time, each row from its first entry in A on), and True; or an empty x and
-    False when its half-bandwidth exceeds ``max_band`` or a pivot is not positive. Row-major numbering makes the band the flooded
-    region's width in cells. Single-threaded by design: LAPACK's banded Cholesky through a
-    threaded BLAS spent tens of times the CPU on these few hundred unknowns on a busy
-    machine."""
+    False when its half-bandwidth exceeds ``max_band`` or a pivot is not positive. Numbered
+    along the region's narrower side, the band is its width in cells. Single-threaded by
+    design: LAPACK's banded Cholesky through a threaded BLAS spent tens of times the CPU on
+    these few hundred unknowns on a busy machine."""
     n = rhs.size
     band = 0
     for i in range(n):

@@ -140,10 +140,14 @@ class Operators:
         p = np.full(flooded.shape, np.nan)
         if not flooded.any():
             return p
-        data, indices, indptr, rhs = pressure_system(
+        data, indices, indptr, rhs, by_column = pressure_system(
             flooded, c, self.h, self.d, dt, self.u, self.gx, self.gy, self.cx, faces.gx,
             faces.gy, faces.px, faces.py, self.q_supply, self.g_side, self.g_out, self.cx_out)
-        p[flooded] = _solve(data, indices, indptr, rhs)
+        x = _solve(data, indices, indptr, rhs)
+        if by_column:
+            p.T[flooded.T] = x
+        else:
+            p[flooded] = x
         return p
 
     def step(self, flooded: np.ndarray, c: np.ndarray, dt: float,
@@ -260,8 +264,8 @@ MAX_BAND = 64
 def _solve(data: np.ndarray, indices: np.ndarray, indptr: np.ndarray,
            rhs: np.ndarray) -> np.ndarray:
     """The flooded cells' pressure from their symmetric positive definite system (CSR): a
-    banded Cholesky factorisation (twice as fast as sparse LU on a region a few tens of
-    cells wide), sparse LU where the band is wider or a pivot not positive."""
+    banded Cholesky factorisation where the band (the region's narrower side, in cells) is
+    up to ``MAX_BAND`` wide, sparse LU where it is wider or a pivot not positive."""
     x, ok = band_cholesky_solve(data, indices, indptr, rhs, MAX_BAND)
     if ok:
         return x
