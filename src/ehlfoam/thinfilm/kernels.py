@@ -363,3 +363,57 @@ def hold_back(qx, qy, q_last, q_side, q_supply, held, opn, draw_x, draw_y, layer
                 for j in range(nx):
                     q_side[j] *= scale[ny - 1, j]
     return qx, qy, q_last, q_side
+
+
+@njit(cache=True)
+def _poiseuille(f_lo, f_hi, p_lo, p_hi, g, g_m, p_m):
+    """Poiseuille flux lo -> hi [m3/s] across one face: between two flooded cells, or from a
+    flooded cell to the meniscus in its open neighbour; none between open cells."""
+    if f_lo and f_hi:
+        return g * (p_lo - p_hi)
+    if f_lo:
+        return g_m * (p_lo - p_m)
+    if f_hi:
+        return g_m * (p_m - p_hi)
+    return 0.0
+
+
+@njit(cache=True)
+def face_fluxes(flooded, p, c, cavity, island, cap, film, hx_m, gx, gy, cx, mgx, mpx, mgy,
+                mpy, u, d):
+    """The faces' fluxes lo -> hi before any open cell is held to what it holds [m3/s]
+    (:meth:`ehlfoam.thinfilm.operators.Operators.move`): on x faces Poiseuille where a side
+    is flooded plus what the walls carry (a full gap, Couette, out of a flooded cell; the
+    films f h a receding meniscus lays out of the cell behind one, h its gap there
+    ``hx_m``; at most the films ``cap`` out of an open cell beside the region; else the
+    cell's oil, all of a cavity's), on y faces Poiseuille alone; the faces on which an open
+    cell gives to a flooded one; and the cells behind a receding meniscus."""
+    ny, nx = flooded.shape
+    qx = np.empty((ny, nx - 1))
+    qy = np.empty((ny - 1, nx))
+    draw_x = np.zeros((ny, nx - 1), np.bool_)
+    draw_y = np.zeros((ny - 1, nx), np.bool_)
+    layer = np.zeros((ny, nx), np.bool_)
+    for i in range(ny):
+        for j in range(nx - 1):
+            fl, fr = flooded[i, j], flooded[i, j + 1]
+            touch = False
+            if not fl and not island[i, j] and not cavity[i, j]:
+                touch = ((i > 0 and flooded[i - 1, j]) or (i + 1 < ny and flooded[i + 1, j])
+                         or (j > 0 and flooded[i, j - 1]) or fr)
+            carry = min(c[i, j], cap[i, j]) if touch and not fr else c[i, j]
+            if (j > 0 and flooded[i, j - 1] and not fl and not fr
+                    and not cavity[i, j]):      # behind a receding meniscus: its films
+                carry = film * hx_m[i, j - 1]
+                layer[i, j] = True
+            q = _poiseuille(fl, fr, p[i, j], p[i, j + 1], gx[i, j], mgx[i, j], mpx[i, j])
+            q += cx[i, j] if fl else u * carry * d * (1.0 if gx[i, j] > 0 else 0.0)
+            qx[i, j] = q
+            draw_x[i, j] = (not fl and fr and q > 0) or (fl and not fr and q < 0)
+    for i in range(ny - 1):
+        for j in range(nx):
+            lo, hi = flooded[i, j], flooded[i + 1, j]
+            q = _poiseuille(lo, hi, p[i, j], p[i + 1, j], gy[i, j], mgy[i, j], mpy[i, j])
+            qy[i, j] = q
+            draw_y[i, j] = (not lo and hi and q > 0) or (lo and not hi and q < 0)
+    return qx, qy, draw_x, draw_y, layer

@@ -14,8 +14,8 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
 from ehlfoam.thinfilm.cavity import cavities
-from ehlfoam.thinfilm.kernels import (band_cholesky_solve, hold_back, meniscus_faces, net_inflow,
-                                      pressure_system)
+from ehlfoam.thinfilm.kernels import (band_cholesky_solve, face_fluxes, hold_back, meniscus_faces,
+                                      net_inflow, pressure_system)
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
@@ -194,31 +194,18 @@ class Operators:
         u, d = self.u, self.d
         if cavity is None:
             cavity = np.zeros_like(flooded)
-        fl, fr = flooded[:, :-1], flooded[:, 1:]
-        touch = touches(flooded) & ~self.island & ~cavity
         # x faces lo -> hi: Poiseuille where a side is flooded, plus what the walls carry:
         # a full gap out of a flooded cell, the films a receding meniscus lays out of the
         # cell behind one, at most those films out of a cell beside one, else the layers;
-        # all of a cavity's oil
-        lays = fl[:, :-1] & ~flooded[:, 1:-1] & ~flooded[:, 2:] & ~cavity[:, 1:-1]
-        carry = np.where(touch[:, :-1] & ~fr, np.minimum(c[:, :-1], self.cap[:, :-1]),
-                         c[:, :-1])
-        carry[:, 1:] = np.where(lays, self.film * faces.hx[:, :-1], carry[:, 1:])
-        qx = _face_flux(fl, fr, p[:, :-1], p[:, 1:], self.gx, faces.gx, faces.px)
-        qx += np.where(fl, self.cx, u * carry * d * (self.gx > 0))
-        qy = _face_flux(flooded[:-1], flooded[1:], p[:-1], p[1:], self.gy, faces.gy, faces.py)
+        # all of a cavity's oil; and the faces on which an open cell gives to a flooded one
+        qx, qy, draw_x, draw_y, layer = face_fluxes(
+            flooded, p, c, cavity, self.island, self.cap, float(self.film), faces.hx,
+            self.gx, self.gy, self.cx, faces.gx, faces.px, faces.gy, faces.py, u, d)
         q_side = np.where(flooded[-1], self.g_side * p[-1], 0.0)
         q_last = np.where(flooded[:, -1], self.cx_out + self.g_out * p[:, -1],
                           u * c[:, -1] * d)
         held = c * d * d / dt                          # [m3/s] over the step
         opn = ~flooded & ~self.island
-        # faces on which an open cell gives to a flooded one (lo -> hi positive, hi -> lo
-        # negative)
-        draw_x = (~fl & fr & (qx > 0)) | (fl & ~fr & (qx < 0))
-        draw_y = ((~flooded[:-1] & flooded[1:] & (qy > 0))
-                  | (flooded[:-1] & ~flooded[1:] & (qy < 0)))
-        layer = np.zeros_like(flooded)                 # the cells behind a receding meniscus
-        layer[:, 1:-1] = lays
         qx, qy, q_last, q_side = hold_back(
             qx, qy, np.asarray(q_last, dtype=float), np.asarray(q_side, dtype=float),
             self.q_supply, held, opn, draw_x, draw_y, layer, -1e-12 * self.h * d * d / dt)
@@ -272,15 +259,6 @@ def _solve(data: np.ndarray, indices: np.ndarray, indptr: np.ndarray,
     n = rhs.size
     return spsolve(csr_matrix((data, indices, indptr), shape=(n, n)), rhs,
                    permc_spec="MMD_AT_PLUS_A")
-
-
-def _face_flux(f_lo, f_hi, p_lo, p_hi, g, g_m, p_m):
-    """Poiseuille flux lo -> hi [m3/s]: between two flooded cells, or from a flooded cell to
-    the meniscus in its open neighbour (conductance g_m, pressure p_m); none between open
-    cells."""
-    return np.where(f_lo & f_hi, g * (p_lo - p_hi),
-                    np.where(f_lo & ~f_hi, g_m * (p_lo - p_m),
-                             np.where(~f_lo & f_hi, g_m * (p_m - p_hi), 0.0)))
 
 
 def touches(flooded: np.ndarray) -> np.ndarray:
