@@ -217,10 +217,11 @@ def band_cholesky_solve(data, indices, indptr, rhs, max_band):
     design: LAPACK's banded Cholesky through a threaded BLAS spent tens of times the CPU on
     these few hundred unknowns on a busy machine."""
     n = rhs.size
-    band = 0
+    first = np.arange(n)              # L's rows start where A's do (its profile)
     for i in range(n):
         for k in range(indptr[i], indptr[i + 1]):
-            band = max(band, i - indices[k])
+            first[i] = min(first[i], indices[k])
+    band = np.max(np.arange(n) - first) if n else 0
     if band > max_band:
         return np.empty(0), False
     low = np.zeros((n, band + 1))     # low[i, band + k - i] = L[i, k], k in i - band .. i
@@ -229,10 +230,6 @@ def band_cholesky_solve(data, indices, indptr, rhs, max_band):
             j = indices[k]
             if j <= i:
                 low[i, band + j - i] = data[k]
-    first = np.empty(n, np.int64)     # L's rows start where A's do (its profile)
-    for i in range(n):
-        first[i] = min(indices[indptr[i]:indptr[i + 1]].min(), i) if indptr[i + 1] > indptr[i] \
-            else i
     for i in range(n):
         for j in range(first[i], i + 1):
             s = low[i, band + j - i]
@@ -264,10 +261,10 @@ def net_inflow(qx, qy, q_last, q_side, q_supply):
     y faces (ny - 1, nx)), the supply into the first column and the outflow through the last
     column and the side row."""
     ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
-    net = np.zeros((ny, nx))
+    net = np.empty((ny, nx))
     for i in range(ny):
         for j in range(nx):
-            v = net[i, j]
+            v = 0.0
             if j < nx - 1:
                 v -= qx[i, j]
             if j > 0:
@@ -291,10 +288,10 @@ def _given(qx, qy, q_last, q_side, mx, my, outer):
     """What every cell gives up [m3/s]: its outgoing fluxes on the faces ``mx`` / ``my``
     mark, and through the outlet and the side when ``outer``."""
     ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
-    out = np.zeros((ny, nx))
+    out = np.empty((ny, nx))
     for i in range(ny):
         for j in range(nx):
-            v = out[i, j]
+            v = 0.0
             if j < nx - 1 and mx[i, j]:
                 v += max(qx[i, j], 0.0)
             if j > 0 and mx[i, j - 1]:
