@@ -60,9 +60,9 @@ def thin_film_case(spec: CaseSpec) -> tuple[CaseGeometry, Callable[[Path], None]
     gap, precalc = load_gap(spec.contact)
     options = scene_options(spec)
     prob = problem_from_spec(spec, gap, options)
-    grid = Grid.build(prob)
-    cells = int((~grid.island).sum())
-    a, d = spec.a, grid.cell
+    x, y, island = Grid.layout(prob)      # the run builds the gaps
+    cells = int((~island).sum())
+    a, d = spec.a, float(x[1] - x[0])     # as Grid.cell
     dt = spec.thin_film.courant * d / spec.speed
     summary = json.loads((precalc / "summary.json").read_text())
     hc = float(summary["hc_m"])
@@ -77,7 +77,7 @@ def thin_film_case(spec: CaseSpec) -> tuple[CaseGeometry, Callable[[Path], None]
         hc=hc, contact_flow=spec.speed * hc * 2.0 * a, gap_mismatch=0.0,
         oil_viscosity=spec.oil_viscosity, oil_density=spec.oil_density, solver=spec.solver,
         ambient_pressure=spec.physics.ambient_pressure)
-    marker = {"cell_over_a": options.cell, "cell_m": d, "nx": len(grid.x), "ny": len(grid.y),
+    marker = {"cell_over_a": options.cell, "cell_m": d, "nx": len(x), "ny": len(y),
               "grid_cells": thin_film_cells(spec), "cells": cells,
               "domain_over_a": list(options.domain), "options": asdict(options),
               "cavitation_pressure_gauge_Pa": prob.cavitation_pressure, "time_step_s": dt}

@@ -38,6 +38,7 @@ import math
 from typing import Any
 
 import numpy as np
+from numba import njit
 from scipy import ndimage
 
 from ehlfoam.metrics.raster import Geometry, Raster, check_threshold, raster
@@ -69,24 +70,27 @@ def _edge_mask(shape: tuple[int, int]) -> np.ndarray:
     return edge
 
 
-def _rim_mask(island: np.ndarray) -> np.ndarray:
-    """Pixels outside the island that touch it (8-neighbourhood)."""
-    return ndimage.binary_dilation(island, structure=_EIGHT) & ~island
+def _touching(labels: np.ndarray, count: int, where: np.ndarray) -> np.ndarray:
+    """The pixels of the labelled regions (``labels`` 1..``count``, 0 outside them) that
+    have a pixel in ``where``."""
+    hit = np.zeros(count + 1, dtype=bool)
+    hit[labels[where]] = True
+    hit[0] = False
+    return hit[labels]
 
 
-def _outer_air(gas: np.ndarray) -> tuple[np.ndarray, int]:
-    """(gas connected to the domain edge, number of enclosed gas regions)."""
-    labels, count = ndimage.label(gas, structure=_FOUR)
-    edge_labels = np.unique(labels[_edge_mask(gas.shape) & gas])
-    outer = np.isin(labels, edge_labels) & gas
-    return outer, int(count - len(edge_labels))
+def _outer_air(labels: np.ndarray, count: int) -> tuple[np.ndarray, int]:
+    """(gas connected to the domain edge, number of enclosed gas regions), from the gas's
+    regions (4-connected, ``labels`` 1..``count``)."""
+    outer = _touching(labels, count, _edge_mask(labels.shape))
+    edge_regions = np.unique(labels[_edge_mask(labels.shape)])
+    return outer, int(count - np.count_nonzero(edge_regions))
 
 
 def _flooded(oil: np.ndarray, rim: np.ndarray) -> np.ndarray:
     """Oil pixels connected (8-neighbourhood) to the island rim."""
-    labels, _ = ndimage.label(oil, structure=_EIGHT)
-    rim_labels = np.unique(labels[rim & oil])
-    return np.isin(labels, rim_labels[rim_labels > 0])
+    labels, count = ndimage.label(oil, structure=_EIGHT)
+    return _touching(labels, count, rim)
 
 
 # --------------------------------------------------------------------------
@@ -100,33 +104,40 @@ def _crossing(x0: float, a0: float, x1: float, a1: float, threshold: float) -> f
     return float(x0 + (x1 - x0) * (threshold - a0) / (a1 - a0))
 
 
+@njit(cache=True)
 def _far_extent(region: np.ndarray, alpha: np.ndarray, gas: np.ndarray,
                 coords: np.ndarray, threshold: float) -> float:
-    """Largest coordinate of ``region`` along axis 1 (ascending ``coords``).
+    """Largest coordinate of ``region`` (not empty) along axis 1 (ascending ``coords``).
 
     A region pixel whose next pixel is gas extends to the interpolated
-    ``alpha = threshold`` crossing between the two. Read on the region's bounding box (and
-    the column after it): the same, at a fraction of the raster's cost.
+    ``alpha = threshold`` crossing between the two (the fraction of the step clipped to
+    0-1; 0 where it is not a number).
     """
-    rows, cols = np.flatnonzero(region.any(axis=1)), np.flatnonzero(region.any(axis=0))
-    if rows.size:
-        box = (slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 2))
-        region, alpha, gas, coords = region[box], alpha[box], gas[box], coords[box[1]]
-    reach = np.broadcast_to(coords, region.shape).astype(float).copy()
-    step = np.diff(coords)
-    a0, a1 = alpha[:, :-1], alpha[:, 1:]
-    ends = region[:, :-1] & gas[:, 1:]
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # only ends are kept
-        frac = np.where(ends, (a0 - threshold) / (a0 - a1), 0.0)
-    reach[:, :-1] += np.clip(np.nan_to_num(frac), 0.0, 1.0) * step
-    return float(reach[region].max())
+    best = -np.inf
+    ny, nx = region.shape
+    for i in range(ny):
+        for j in range(nx):
+            if not region[i, j]:
+                continue
+            reach = coords[j]
+            if j + 1 < nx and gas[i, j + 1]:
+                num, den = alpha[i, j] - threshold, alpha[i, j] - alpha[i, j + 1]
+                if den != 0.0:
+                    frac = num / den
+                else:
+                    frac = 1.0 if num > 0.0 else 0.0
+                frac = 0.0 if not frac >= 0.0 else min(frac, 1.0)
+                reach = coords[j] + frac * (coords[j + 1] - coords[j])
+            best = max(best, reach)
+    return best
 
 
 def _extent(region: np.ndarray, alpha: np.ndarray, gas: np.ndarray,
             coords: np.ndarray, threshold: float) -> tuple[float, float]:
     """(min, max) coordinate of ``region`` along axis 1, sub-pixel."""
-    hi = _far_extent(region, alpha, gas, coords, threshold)
-    lo = -_far_extent(region[:, ::-1], alpha[:, ::-1], gas[:, ::-1], -coords[::-1], threshold)
+    hi = _far_extent(region, alpha, gas, np.asarray(coords, dtype=float), threshold)
+    lo = -_far_extent(region[:, ::-1], alpha[:, ::-1], gas[:, ::-1],
+                      -np.asarray(coords, dtype=float)[::-1], threshold)
     return lo, hi
 
 
@@ -196,17 +207,18 @@ def _wake_gas_end(r: Raster, gas: np.ndarray, oil: np.ndarray, threshold: float)
 def bubble_mask(r: Raster, threshold: float = 0.5) -> np.ndarray:
     """The cavitation bubble: gas pixels (4-connected regions) that touch the island rim
     downstream of the contact (rim pixels at x > 0). Empty when oil follows the rim."""
-    gas = r.gas(threshold)
-    rim = _rim_mask(r.island) & (np.broadcast_to(r.x, r.island.shape) > 0.0)
-    labels, _ = ndimage.label(gas, structure=_FOUR)
-    hit = np.unique(labels[rim & gas])
-    return np.isin(labels, hit[hit > 0])
+    return _bubble_mask(r, *ndimage.label(r.gas(threshold), structure=_FOUR))
 
 
-def _bubble(r: Raster, outer: np.ndarray, threshold: float) -> dict[str, Any]:
-    """Bubble metrics (see :func:`flow_pattern`)."""
+def _bubble_mask(r: Raster, labels: np.ndarray, count: int) -> np.ndarray:
+    """:func:`bubble_mask` from the gas's regions (4-connected, ``labels`` 1..``count``)."""
+    return _touching(labels, count, r.rim & (np.broadcast_to(r.x, r.island.shape) > 0.0))
+
+
+def _bubble(r: Raster, outer: np.ndarray, bubble: np.ndarray,
+            threshold: float) -> dict[str, Any]:
+    """Bubble metrics (see :func:`flow_pattern`) of the ``bubble`` pixels."""
     a = r.geom.a
-    bubble = bubble_mask(r, threshold)
     if not bubble.any():
         return {"bubble_length_over_a": 0.0, "bubble_width_over_a": 0.0,
                 "bubble_enclosed": False}
@@ -234,7 +246,7 @@ def advancing_front(r: Raster, track_half_width: float, threshold: float = 0.5) 
     if not (math.isfinite(track_half_width) and track_half_width >= 0):
         raise ValueError(f"track_half_width: must be a finite length >= 0 m, got "
                          f"{track_half_width!r}")
-    flooded = _flooded(r.oil(check_threshold(threshold)), _rim_mask(r.island))
+    flooded = _flooded(r.oil(check_threshold(threshold)), r.rim)
     behind = np.zeros_like(flooded)                # the pixel upstream is flooded or island
     behind[:, 1:] = flooded[:, :-1] | r.island[:, :-1]
     behind[:, 0] = True                            # the domain's upstream edge: not known
@@ -250,8 +262,9 @@ def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
     a = r.geom.a
     oil, gas = r.oil(threshold), r.gas(threshold)
-    rim = _rim_mask(r.island)
-    outer, enclosed = _outer_air(gas)
+    rim = r.rim
+    gas_regions = ndimage.label(gas, structure=_FOUR)
+    outer, enclosed = _outer_air(*gas_regions)
     flooded = _flooded(oil, rim)
     outer_rim = outer & rim
     xx = np.broadcast_to(r.x, r.island.shape)
@@ -301,7 +314,7 @@ def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any
         "wake_open": wake_open,
         "inlet_starved": inlet_starved,
         "enclosed_bubbles": enclosed,
-        **_bubble(r, outer, threshold),
+        **_bubble(r, outer, _bubble_mask(r, *gas_regions), threshold),
         "oil_area_fraction": float(oil.sum() / free.sum()),
         "mean_alpha": float(np.nanmean(r.alpha[free])),
     }
@@ -394,7 +407,7 @@ def flooded_widths_at(r: Raster, x_stations: Any, threshold: float = 0.5) -> lis
     if not isinstance(r, Raster):
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
     oil, gas = r.oil(threshold), r.gas(threshold)
-    flooded = _flooded(oil, _rim_mask(r.island))
+    flooded = _flooded(oil, r.rim)
     alpha = np.nan_to_num(r.alpha, nan=0.0)
     widths: list[float | None] = []
     for x in np.atleast_1d(np.asarray(x_stations, float)):

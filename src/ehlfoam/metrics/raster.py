@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy import ndimage
 from scipy.spatial import QhullError
 
 from ehlfoam.spec.sections import DomainBox
@@ -87,6 +88,18 @@ class Raster:
     def dy(self) -> float:
         """Pixel spacing along y [m]."""
         return float(self.y[1] - self.y[0])
+
+    @functools.cached_property
+    def rim(self) -> np.ndarray:
+        """Pixels outside the island that touch it (8-neighbourhood), (ny, nx)."""
+        island, rim = self.island, np.zeros_like(self.island)
+        rows, cols = np.flatnonzero(island.any(axis=1)), np.flatnonzero(island.any(axis=0))
+        if rows.size:          # on the island's bounding box and a pixel round it
+            box = (slice(max(rows[0] - 1, 0), rows[-1] + 2),
+                   slice(max(cols[0] - 1, 0), cols[-1] + 2))
+            near = island[box]
+            rim[box] = ndimage.binary_dilation(near, structure=np.ones((3, 3), bool)) & ~near
+        return rim
 
     @property
     def axis_row(self) -> int:

@@ -212,14 +212,22 @@ class Grid:
     def cell(self) -> float:
         return float(self.x[1] - self.x[0])
 
-    @classmethod
-    def build(cls, prob: ThinFilmProblem) -> "Grid":
+    @staticmethod
+    def layout(prob: ThinFilmProblem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The grid's cell centres x (nx,), y (ny,) [m] and its island (ny, nx), without
+        the gaps (which cost the far field's sum)."""
         d = prob.cell
         nx = int(round((prob.x_range[1] - prob.x_range[0]) / d))
         ny = int(round(prob.y_max / d))
         x = prob.x_range[0] + d * (np.arange(nx) + 0.5)
         y = d * (np.arange(ny) + 0.5)
-        island = np.hypot(*np.meshgrid(x, y)) < prob.island_radius
+        return x, y, np.hypot(*np.meshgrid(x, y)) < prob.island_radius
+
+    @classmethod
+    def build(cls, prob: ThinFilmProblem) -> "Grid":
+        d = prob.cell
+        x, y, island = cls.layout(prob)
+        nx, ny = len(x), len(y)
         xf = prob.x_range[0] + d * np.arange(1, nx)
         yf = d * np.arange(1, ny)
         return cls(x=x, y=y, h=_gap(prob.gap, *np.meshgrid(x, y), island),
