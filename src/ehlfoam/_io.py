@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import shutil
 import tempfile
 import tomllib
 from collections.abc import Callable
@@ -18,7 +19,7 @@ from typing import IO, Any
 from ehlfoam.errors import SpecError
 
 __all__ = ["MAX_SPEC_BYTES", "atomic_write", "atomic_write_json", "atomic_write_text",
-           "finite_or_none", "read_toml"]
+           "finite_or_none", "link_tree", "read_toml"]
 
 #: The largest spec file read [bytes]: a spec is a few kB (a mesh.refine band of 10,000
 #: points some 0.3 MB); a larger file is refused by its size, before it is read.
@@ -36,6 +37,22 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[IO[bytes]], Any]
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def link_tree(src: str | os.PathLike[str], dst: str | os.PathLike[str]) -> None:
+    """``dst``, a new folder, with ``src``'s files: hard links where the file system allows
+    (no room taken: an EHL precalc is some 14 MB on its finest grid, and every case keeps
+    one), copies elsewhere. For files never changed in place: this package writes files by
+    renaming a new one over the old (:func:`atomic_write`), which leaves a link's other
+    names as they were."""
+    def link(a: str, b: str) -> str:
+        try:
+            os.link(a, b)
+        except OSError:
+            shutil.copy2(a, b)
+        return b
+
+    shutil.copytree(src, dst, copy_function=link)
 
 
 def finite_or_none(value: Any) -> Any:

@@ -153,3 +153,19 @@ def test_load_from_output_dir_matches(solved, gap, consts, tmp_path_factory):
     h1 = gap(pts[:, 0] * a, pts[:, 1] * a)
     h2 = g2(pts[:, 0] * a, pts[:, 1] * a)
     assert np.allclose(h2, h1, rtol=1e-9, atol=0)
+
+
+def test_a_linked_precalc_is_read_once_and_a_new_one_again(solved, tmp_path_factory):
+    """A case's precalc is a hard link to the cache's: the same file, read once in a
+    process; a precalc written anew (a new file) is read again."""
+    from ehlfoam._io import link_tree
+
+    cache = tmp_path_factory.mktemp("cache")
+    write_all(solved, cache)
+    case = tmp_path_factory.mktemp("case") / "precalc"
+    link_tree(cache, case)
+    assert (case / "solution.npz").stat().st_ino == (cache / "solution.npz").stat().st_ino
+    assert GapField.load(case) is GapField.load(cache)
+    other = tmp_path_factory.mktemp("other")
+    write_all(solved, other)
+    assert GapField.load(other) is not GapField.load(cache)

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
@@ -26,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ehlfoam._io import atomic_write_json, atomic_write_text
+from ehlfoam._io import atomic_write_json, atomic_write_text, link_tree
 from ehlfoam.case.geometry import META, CaseGeometry
 from ehlfoam.gap.source import load_gap
 from ehlfoam.spec.case import CaseSpec
@@ -88,6 +87,6 @@ def thin_film_case(spec: CaseSpec) -> tuple[CaseGeometry, Callable[[Path], None]
         atomic_write_text(meta / "spec.json", spec.model_dump_json(indent=2) + "\n")
         atomic_write_json(meta / "geometry.json", asdict(geom))
         atomic_write_json(meta / MARKER, marker)
-        shutil.copytree(precalc, folder / "precalc")
+        link_tree(precalc, folder / "precalc")
 
     return geom, fill

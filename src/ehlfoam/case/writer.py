@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ehlfoam._io import atomic_write_json, atomic_write_text
+from ehlfoam._io import atomic_write_json, atomic_write_text, link_tree
 from ehlfoam.case.bounds import check_work
 from ehlfoam.case.dictionaries import edit_physics_dicts, edit_run_control, release_geometry
 from ehlfoam.case.fields import edit_fields, with_supply_patch
@@ -171,7 +171,7 @@ def write_case(spec: CaseSpec, out: str | os.PathLike, runtime: FoamRuntime | No
         atomic_write_text(meta / "spec.json", spec.model_dump_json(indent=2) + "\n")
         atomic_write_json(meta / "geometry.json", asdict(geom))
         _save_structure(meta / "mesh.npz", mesh)
-        shutil.copytree(precalc, tmp / "precalc")
+        link_tree(precalc, tmp / "precalc")
 
     _build(out, overwrite, fill, prepare)
     return geom

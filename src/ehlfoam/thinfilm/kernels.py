@@ -138,6 +138,24 @@ def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_s
 
 
 @njit(cache=True)
+def fill(c, h, layers, cavity):
+    """How far into each cell a meniscus beside it reaches, 0-1
+    (:meth:`ehlfoam.thinfilm.operators.Operators.fill`): the bulk oil ``c - layers`` over
+    the room ``h - layers`` for it; in a ``cavity`` cell, ``c / h``."""
+    ny, nx = c.shape
+    out = np.empty((ny, nx))
+    for i in range(ny):
+        for j in range(nx):
+            if cavity[i, j]:
+                v = c[i, j] / (h[i, j] if h[i, j] > 0 else 1.0)
+            else:
+                room = h[i, j] - layers[i, j]
+                v = (c[i, j] - layers[i, j]) / (room if room > 0 else 1.0)
+            out[i, j] = min(max(v, 0.0), 1.0)
+    return out
+
+
+@njit(cache=True)
 def meniscus_faces(flooded, theta, h, factor, young_laplace, g, cavity, gas, p_cav,
                    has_cav, has_gas, axis):
     """On every face along ``axis`` (1: x faces (ny, nx - 1), 0: y faces (ny - 1, nx)) the

@@ -14,8 +14,8 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
 from ehlfoam.thinfilm.cavity import cavities
-from ehlfoam.thinfilm.kernels import (band_cholesky_solve, face_fluxes, hold_back, meniscus_faces,
-                                      net_inflow, pressure_system)
+from ehlfoam.thinfilm.kernels import (band_cholesky_solve, face_fluxes, fill, hold_back,
+                                      meniscus_faces, net_inflow, pressure_system)
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
@@ -63,6 +63,8 @@ class Operators:
         # layers ahead of the contact, the films elsewhere [m]
         ahead = (grid.x < 0)[None, :] & np.ones_like(self.island)
         self.layers = np.where(ahead, np.maximum(incoming[:, None], self.cap), self.cap)
+        self._ones = np.ones_like(self.h)              # the static menisci's factor
+        self._short = -1e-12 * self.h * d * d          # a cell short of oil: below it / dt
 
     def pull_factor(self, flooded: np.ndarray) -> np.ndarray | float:
         """The dynamic menisci's pressure on every cell, a factor on the static one. The
@@ -90,12 +92,9 @@ class Operators:
         """How far into each cell a meniscus beside it reaches: the cell's bulk oil (beyond
         the walls' layers) over its room for it, 0-1; in a cavity, its film content over
         its gap (the oil the walls carry through it: Elrod-Adams's fraction)."""
-        room = self.h - self.layers
-        out = np.clip((c - self.layers) / np.where(room > 0, room, 1.0), 0.0, 1.0)
-        if cavity is None or not cavity.any():
-            return out
-        full = np.clip(c / np.where(self.h > 0, self.h, 1.0), 0.0, 1.0)
-        return np.where(cavity, full, out)
+        if cavity is None:
+            cavity = np.zeros(c.shape, dtype=bool)
+        return fill(c, self.h, self.layers, cavity)
 
     def cavities(self, flooded: np.ndarray) -> np.ndarray:
         """The open cells whose gas the flooded region encloses, at the cavitation pressure
@@ -119,8 +118,8 @@ class Operators:
         like the outer air's, Young-Laplace's below that gas pressure, floored alike."""
         if cavity is None:
             cavity = np.zeros_like(flooded)
-        factor = np.ascontiguousarray(np.broadcast_to(self.pull_factor(flooded), flooded.shape),
-                                      dtype=float)
+        factor = self.pull_factor(flooded)
+        factor = self._ones if np.isscalar(factor) else np.ascontiguousarray(factor, dtype=float)
         theta = 0.5 + self.fill(c, cavity) if self.sub_cell else np.ones_like(c)
         has_gas = gas is not None and self.p_cav is not None
         gas = np.asarray(gas, dtype=float) if has_gas else self.h
@@ -208,7 +207,7 @@ class Operators:
         opn = ~flooded & ~self.island
         qx, qy, q_last, q_side = hold_back(
             qx, qy, np.asarray(q_last, dtype=float), np.asarray(q_side, dtype=float),
-            self.q_supply, held, opn, draw_x, draw_y, layer, -1e-12 * self.h * d * d / dt)
+            self.q_supply, held, opn, draw_x, draw_y, layer, self._short / dt)
         net = net_inflow(qx, qy, q_last, q_side, self.q_supply)
         out = net * dt / (d * d), float(q_last.sum()), float(q_side.sum())
         return (*out, q_last) if by_row else out
