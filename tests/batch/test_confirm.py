@@ -108,3 +108,22 @@ def test_the_confirmations_are_the_brackets_of_the_lines_confirm_only_names(tmp_
                                                  "only": {"supply.disc_layer": 1e-6}}}, "map")
     assert [pc.params["contact.speed"] for pc in confirm_plan(only, plan, rows, tmp_path)] == \
         [0.017, 0.03]
+
+
+def test_a_3d_confirmation_that_opens_a_closed_region_says_why():
+    """The 3D levels drain a state I region (their films): a confirmation in state II
+    against the thin-film's I says so and points at the docs; one in I against II, or one
+    that agrees, does not."""
+    from ehlfoam.report.regime import DRAINS, summary_lines
+
+    def conf(state, thin_film_state):
+        return {"confirm_rung": "coarse", "rung": "thin-film-coarse", "contact.speed": 0.008,
+                "supply": "0.45 um", "contact.temperature": 40.0, "contact.load": 20.0,
+                "state": state, "thin_film_state": thin_film_state,
+                "agree": state == thin_film_state}
+
+    lines = summary_lines({"confirmations": [conf("II", "I"), conf("I", "II"), conf("I", "I")]})
+    assert DRAINS in lines[0] and "disagrees" in lines[0]
+    assert "disagrees" in lines[1] and DRAINS not in lines[1]
+    assert "agrees" in lines[2] and DRAINS not in lines[2]
+    assert lines[-1].startswith("3D confirmations: 1 of 3 agree")

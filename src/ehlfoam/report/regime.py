@@ -15,6 +15,10 @@ from ehlfoam.report import units
 __all__ = ["FIGURES", "hysteresis_figure", "speed_supply_figure", "speed_temperature_figure",
            "summary_lines", "transition_text", "write_figures"]
 
+#: why a 3D level opens a region the thin-film rung keeps closed (its films)
+DRAINS = ("the 3D levels lay films 1.5-2 times the model's and drain a state I region: "
+          "docs/ladder.md#why-the-3d-levels-drain-at-state-i")
+
 _U = units.SPEC[SPEED]
 _T = units.SPEC["contact.temperature"]
 _F = units.SPEC["contact.load"]
@@ -79,6 +83,8 @@ def summary_lines(result: dict) -> list[str]:
     confs = result.get("confirmations", [])
     for c in confs:
         verdict = {True: "agrees", False: "disagrees", None: "no state yet"}[c["agree"]]
+        if c["agree"] is False and (c["state"], c["thin_film_state"]) == ("II", "I"):
+            verdict += f" ({DRAINS})"
         lines.append(f"3D confirmation ({_rung_text(c['confirm_rung'])}) of "
                      f"{_rung_text(c['rung'])} at {_u(c[SPEED]):.4g} {_U.unit}, "
                      f"{c['supply']}, {_conditions(c)}: state {c['state'] or '-'} against "
