@@ -34,10 +34,8 @@ from __future__ import annotations
 
 import csv
 import io
-import signal
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -51,7 +49,7 @@ from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run.fields import Sample
 from ehlfoam.run.history import write_history
 from ehlfoam.run.thin_film import (MARCH_ERRORS, STATE_FILE, advance, open_march,
-                                   sigterm_interrupts, swapped_handlers)
+                                   sigterm_interrupts, signals_held)
 from ehlfoam.run.thin_film_record import Accounts, sample, thin_film_record
 from ehlfoam.spec.case import CaseSpec
 from ehlfoam.spec.cycle import rig_layers
@@ -146,7 +144,7 @@ def _cycle(path: Path, spec: CaseSpec, geom: CaseGeometry, wall_limit: float,
                 took, side = m.oil_in - took, m.oil_out_side - side0
                 s, before = sample(m, t0, geom, before)
                 film = starved_film(spec.contact, _film_meniscus(s.pattern))
-                with _signals_held():   # a pass is booked whole: its tracks, row and files
+                with signals_held():   # a pass is booked whole: its tracks, row and files
                     history.append(s)
                     arc = tracks.next_arc
                     tracks.lay(rig, m.oil_out_rows, side)
@@ -268,23 +266,6 @@ def _start_tracks(path: Path, spec: CaseSpec, rig: Rig) -> Tracks:
                          "of the same contact grid, track radius and cycle.side")
     tracks.passes = 0
     return tracks
-
-
-@contextmanager
-def _signals_held() -> Iterator[None]:
-    """SIGTERM and SIGINT wait until the block is done (then interrupt: KeyboardInterrupt),
-    so that an interrupt never leaves a pass half booked: its row counted but its files not
-    written. Their Python handlers are swapped for the block, not the signals masked: a mask
-    holds them in this thread only, and the numba and FFT threads can take them (nothing is
-    held where handlers cannot be set: not the main thread)."""
-    caught: list[int] = []
-
-    def hold(signum: int, frame: object) -> None:
-        caught.append(signum)
-    with swapped_handlers((signal.SIGTERM, signal.SIGINT), hold):
-        yield
-    if caught:
-        raise KeyboardInterrupt
 
 
 def cycle_end(rows: list[dict], arcs: int, tol: float, period_max: int

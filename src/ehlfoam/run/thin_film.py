@@ -53,7 +53,8 @@ from ehlfoam.thinfilm.solution import ThinFilmSolution
 from ehlfoam.thinfilm.state import load_state, save_state
 
 __all__ = ["FRAMES_DIR", "MARCH_ERRORS", "STATE_FILE", "advance", "open_march",
-           "run_thin_film_case", "sigterm_interrupts", "start_of", "swapped_handlers"]
+           "run_thin_film_case", "sigterm_interrupts", "signals_held", "start_of",
+           "swapped_handlers"]
 
 #: the state a thin-film run ends with, in the case folder
 STATE_FILE = "state.npz"
@@ -290,25 +291,37 @@ _CAUGHT: list[int] = []
 
 
 @contextmanager
-def sigterm_interrupts() -> Iterator[None]:
-    """Within the block SIGTERM and SIGINT interrupt the march between two steps:
-    :func:`advance` raises KeyboardInterrupt after the step it was in (the run ends
-    ``interrupted``, its state written whole), or the block's end does when no step came
-    after. Raised the moment the signal came, the interrupt could land inside a step, or in
-    a numba kernel's return, where it became a SystemError (an internal error). The
-    handlers before are put back after the block; nothing changes where signals cannot be
-    set (not the main thread)."""
+def signals_held(noted: list[int] | None = None) -> Iterator[None]:
+    """Within the block SIGTERM and SIGINT are noted in ``noted`` (a list of their numbers),
+    not raised; at its end a noted one interrupts (KeyboardInterrupt), unless the block
+    raised. Their Python handlers are swapped for the block, not the signals masked: a mask
+    holds them in this thread only, and the numba and FFT threads can take them; nothing
+    changes where handlers cannot be set (not the main thread)."""
+    noted = [] if noted is None else noted
+
     def note(signum: int, frame: object) -> None:
-        _CAUGHT.append(signum)
-    _CAUGHT.clear()
+        noted.append(signum)
     with swapped_handlers((signal.SIGTERM, signal.SIGINT), note):
         try:
             yield
         finally:
-            caught = bool(_CAUGHT)
-            _CAUGHT.clear()
+            caught = bool(noted)
+            noted.clear()
     if caught:
         raise KeyboardInterrupt
+
+
+@contextmanager
+def sigterm_interrupts() -> Iterator[None]:
+    """Within the block SIGTERM and SIGINT interrupt the march between two steps:
+    :func:`advance` raises KeyboardInterrupt after the step it was in (the run ends
+    ``interrupted``, its state written whole), or the block's end does when no step came
+    after (:func:`signals_held`). Raised the moment the signal came, the interrupt could
+    land inside a step, or in a numba kernel's return, where it became a SystemError (an
+    internal error)."""
+    _CAUGHT.clear()
+    with signals_held(_CAUGHT):
+        yield
 
 
 class _Log:
