@@ -31,7 +31,9 @@ TRUST = {
         "3D coarse (minutes a case): a first look; the flooded width 17-21 % short of the "
         "converged one, the inlet some 16 % upstream; a few transits are not a rest: started "
         "from the thin-film state it was still shedding oil after 1-6 transits at 5 of 6 "
-        "points of 4-21 mm/s (docs/models/stability.md, docs/ladder.md)."),
+        "points of 4-21 mm/s (docs/models/stability.md, docs/ladder.md); its rear menisci lay "
+        "films 1.5-2 times the thin-film model's, so it drains a state I region toward "
+        "state II (docs/ladder.md#why-the-3d-levels-drain-at-state-i)."),
     "medium": (
         "3D medium: the default levels' width 17-21 % short of the converged one "
         "(docs/validation.md)."),
