@@ -185,6 +185,9 @@ def test_a_run_goes_on_from_its_state(ran, tmp_path, capsys):
 
 def test_a_wall_limit_ends_the_run_with_its_state(ran, tmp_path):
     case = copy_of(ran, tmp_path)
+    spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
+    spec["run"]["steady_tolerance"] = 1e-9        # never steady: only the wall limit ends it
+    (case / "ehlfoam" / "spec.json").write_text(json.dumps(spec))
     assert main(["run", str(case), "--wall-limit", "0.3", "--quiet"]) == 0
     m = metrics(case)
     assert (m["status"], m["end_reason"]) == ("finished", "wall_limit")

@@ -84,3 +84,30 @@ def test_the_pressure_is_the_same_by_band_or_by_sparse_lu(monkeypatch):
     scale = np.max(np.abs(by_lu[flooded]))
     assert scale > 0
     assert np.max(np.abs(banded[flooded] - by_lu[flooded])) <= 1e-12 * scale
+
+
+def test_the_outer_air_grown_from_a_smaller_gas_is_the_outer_air_found_anew():
+    """Opening flooded cells only adds gas: the outer air grown from the one before (the
+    step's second and later passes) is the one a flood fill from the edges finds, with a
+    closed side or an open one, including cavities the new gas joins to the outer air."""
+    from ehlfoam.thinfilm.kernels import edge_connected, edge_connected_from
+    from scipy import ndimage
+
+    rng = np.random.default_rng(7)
+    joined = 0
+    for k in range(300):
+        closed = bool(k % 2)
+        gas = rng.random((rng.integers(3, 30), rng.integers(3, 40))) < rng.uniform(0.3, 0.7)
+        more = gas | (rng.random(gas.shape) < rng.uniform(0.0, 0.2))
+        before = edge_connected(gas, closed)
+        grown = edge_connected_from(more, closed, before)
+        assert (grown == edge_connected(more, closed)).all()
+        # against scipy: the 4-connected regions of the gas that touch the open edges
+        labels, _ = ndimage.label(more)
+        edges = np.zeros_like(more)
+        edges[:, 0] = edges[:, -1] = True
+        edges[-1, :] |= not closed
+        touching = np.unique(labels[edges & more])
+        assert (grown == (np.isin(labels, touching) & more)).all()
+        joined += int((grown & gas & ~before).any())
+    assert joined > 10          # the new gas did join enclosed gas to the outer air

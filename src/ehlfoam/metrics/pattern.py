@@ -53,6 +53,7 @@ __all__ = [
     "flow_pattern",
     "flow_pattern_from_raster",
     "meniscus_contours",
+    "pattern_and_bubble",
     "raster",
 ]
 
@@ -257,6 +258,12 @@ def advancing_front(r: Raster, track_half_width: float, threshold: float = 0.5) 
 
 def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any]:
     """Flow-pattern metrics of a :class:`Raster`; see :func:`flow_pattern`."""
+    return pattern_and_bubble(r, threshold)[0]
+
+
+def pattern_and_bubble(r: Raster, threshold: float = 0.5) -> tuple[dict[str, Any], np.ndarray]:
+    """:func:`flow_pattern_from_raster`'s metrics and the bubble's pixels
+    (:func:`bubble_mask`), read together: a caller that needs both labels the gas once."""
     threshold = check_threshold(threshold)
     if not isinstance(r, Raster):
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
@@ -265,6 +272,7 @@ def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any
     rim = r.rim
     gas_regions = ndimage.label(gas, structure=_FOUR)
     outer, enclosed = _outer_air(*gas_regions)
+    bubble = _bubble_mask(r, *gas_regions)
     flooded = _flooded(oil, rim)
     outer_rim = outer & rim
     xx = np.broadcast_to(r.x, r.island.shape)
@@ -298,7 +306,7 @@ def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any
     wake_end = _wake_gas_end(r, gas, oil, threshold)
     wake = 0.0 if wake_end is None else max(0.0, (wake_end - a) / a)
     free = ~r.island
-    return {
+    return ({
         "state": state,
         "inlet_meniscus_distance_over_a": inlet,
         "inlet_meniscus_at_rim": bool(inlet_at_rim),
@@ -314,10 +322,10 @@ def flow_pattern_from_raster(r: Raster, threshold: float = 0.5) -> dict[str, Any
         "wake_open": wake_open,
         "inlet_starved": inlet_starved,
         "enclosed_bubbles": enclosed,
-        **_bubble(r, outer, _bubble_mask(r, *gas_regions), threshold),
+        **_bubble(r, outer, bubble, threshold),
         "oil_area_fraction": float(oil.sum() / free.sum()),
         "mean_alpha": float(np.nanmean(r.alpha[free])),
-    }
+    }, bubble)
 
 
 def flow_pattern(x: Any, y: Any, alpha: Any, geom: Geometry, threshold: float = 0.5,

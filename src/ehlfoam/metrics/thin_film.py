@@ -16,7 +16,7 @@ import numpy as np
 from scipy import ndimage
 from scipy.sparse import csr_matrix
 
-from ehlfoam.metrics.pattern import bubble_mask, flow_pattern_from_raster
+from ehlfoam.metrics.pattern import pattern_and_bubble
 from ehlfoam.metrics.raster import DEFAULT_CELL_OVER_A, Geometry, Raster, _grid
 from ehlfoam.thinfilm.solution import ThinFilmSolution
 
@@ -64,10 +64,10 @@ def thin_film_raster(sol: ThinFilmSolution, geom: Geometry,
     return Raster(x=xs, y=ys, alpha=values, island=island, geom=geom)
 
 
-def _bubble_volume(r: Raster, sol: ThinFilmSolution) -> float:
-    """Gas [m3, whole contact] in the model's cells under the bubble's footprint (the
-    :func:`bubble_mask` pixels at their centres): their gap less their oil."""
-    mask = bubble_mask(r)
+def _bubble_volume(r: Raster, sol: ThinFilmSolution, mask: np.ndarray) -> float:
+    """Gas [m3, whole contact] in the model's cells under the bubble's footprint (``mask``,
+    the :func:`~ehlfoam.metrics.pattern.bubble_mask` pixels, at their centres): their gap
+    less their oil."""
     if not mask.any():
         return 0.0
     grid = sol.grid
@@ -83,6 +83,6 @@ def thin_film_pattern(sol: ThinFilmSolution, geom: Geometry) -> tuple[dict, Rast
     ``bubble_volume_m3``: the gas under the bubble, whole contact) and the raster they were
     read from."""
     r = thin_film_raster(sol, geom)
-    pattern = flow_pattern_from_raster(r)
-    pattern["bubble_volume_m3"] = _bubble_volume(r, sol)
+    pattern, bubble = pattern_and_bubble(r)
+    pattern["bubble_volume_m3"] = _bubble_volume(r, sol, bubble)
     return pattern, r

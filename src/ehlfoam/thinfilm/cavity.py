@@ -30,20 +30,28 @@ from __future__ import annotations
 
 import numpy as np
 
-from ehlfoam.thinfilm.kernels import edge_connected
+from ehlfoam.thinfilm.kernels import edge_connected, edge_connected_from
 
 __all__ = ["cavities", "outer_air"]
 
 
-def outer_air(gas: np.ndarray, closed_side: bool = False) -> np.ndarray:
+def outer_air(gas: np.ndarray, closed_side: bool = False,
+              before: np.ndarray | None = None) -> np.ndarray:
     """The cells of ``gas`` (bool, ny x nx: the open cells) connected through other gas cells
     (4-neighbours) to the domain's open edges: the upstream column, the outlet column and,
-    unless ``closed_side``, the side row y = y_max (row 0 is the symmetry plane y = 0)."""
-    return edge_connected(np.ascontiguousarray(gas, dtype=np.bool_), closed_side)
+    unless ``closed_side``, the side row y = y_max (row 0 is the symmetry plane y = 0).
+    ``before``: the outer air of a gas that ``gas`` holds (the open cells before some
+    flooded ones opened), grown from rather than found anew."""
+    gas = np.ascontiguousarray(gas, dtype=np.bool_)
+    if before is None:
+        return edge_connected(gas, closed_side)
+    return edge_connected_from(gas, closed_side, np.ascontiguousarray(before, dtype=np.bool_))
 
 
-def cavities(flooded: np.ndarray, island: np.ndarray, closed_side: bool = False) -> np.ndarray:
+def cavities(flooded: np.ndarray, island: np.ndarray, closed_side: bool = False,
+             before: np.ndarray | None = None) -> np.ndarray:
     """The open cells whose gas the flooded region encloses (bool, ny x nx): not flooded, not
-    island, and not connected to the outer air (:func:`outer_air`)."""
+    island, and not connected to the outer air (:func:`outer_air`; ``before``: the outer
+    air of a flooded set that held this one)."""
     gas = ~flooded & ~island
-    return gas & ~outer_air(gas, closed_side)
+    return gas & ~outer_air(gas, closed_side, before)

@@ -64,76 +64,77 @@ def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_s
     row_cols = np.empty(5, np.int64)
     row_vals = np.empty(5)
     k = 0
-    for m in range(ny * nx):
-        i, j = (m % ny, m // ny) if by_column else (m // nx, m % nx)
-        r = idx[i, j]
-        if r < 0:
-            continue
-        b = ((c[i, j] - h[i, j]) * d * d / dt)
-        # x faces: to the right (this cell lo), to the left (this cell hi)
-        right = j + 1 < nx and gx[i, j] > 0
-        left = j > 0 and gx[i, j - 1] > 0
-        if right and flooded[i, j + 1]:
-            b += -cx[i, j]
-        if left and flooded[i, j - 1]:
-            b += cx[i, j - 1]
-        if right and not flooded[i, j + 1]:
-            b += -cx[i, j] + mgx[i, j] * mpx[i, j]
-        if left and not flooded[i, j - 1]:
-            b += u * c[i, j - 1] * d + mgx[i, j - 1] * mpx[i, j - 1]
-        # y faces: below (this cell lo), above (this cell hi): no Couette flux
-        down = i + 1 < ny and gy[i, j] > 0
-        up = i > 0 and gy[i - 1, j] > 0
-        if down and not flooded[i + 1, j]:
-            b += mgy[i, j] * mpy[i, j]
-        if up and not flooded[i - 1, j]:
-            b += mgy[i - 1, j] * mpy[i - 1, j]
-        if j == 0:
-            b += q_supply[i]
-        if j == nx - 1:
-            b += -cx_out[i]
-        rhs[r] = b
-        # the row's entries: its flooded neighbours, then the diagonal
-        e = 0
-        diag = 0.0
-        if up and flooded[i - 1, j]:
-            row_cols[e], row_vals[e] = idx[i - 1, j], -gy[i - 1, j]
+    for outer in range(nx if by_column else ny):     # y fastest by column, x by row
+        for inner in range(ny if by_column else nx):
+            i, j = (inner, outer) if by_column else (outer, inner)
+            r = idx[i, j]
+            if r < 0:
+                continue
+            b = ((c[i, j] - h[i, j]) * d * d / dt)
+            # x faces: to the right (this cell lo), to the left (this cell hi)
+            right = j + 1 < nx and gx[i, j] > 0
+            left = j > 0 and gx[i, j - 1] > 0
+            if right and flooded[i, j + 1]:
+                b += -cx[i, j]
+            if left and flooded[i, j - 1]:
+                b += cx[i, j - 1]
+            if right and not flooded[i, j + 1]:
+                b += -cx[i, j] + mgx[i, j] * mpx[i, j]
+            if left and not flooded[i, j - 1]:
+                b += u * c[i, j - 1] * d + mgx[i, j - 1] * mpx[i, j - 1]
+            # y faces: below (this cell lo), above (this cell hi): no Couette flux
+            down = i + 1 < ny and gy[i, j] > 0
+            up = i > 0 and gy[i - 1, j] > 0
+            if down and not flooded[i + 1, j]:
+                b += mgy[i, j] * mpy[i, j]
+            if up and not flooded[i - 1, j]:
+                b += mgy[i - 1, j] * mpy[i - 1, j]
+            if j == 0:
+                b += q_supply[i]
+            if j == nx - 1:
+                b += -cx_out[i]
+            rhs[r] = b
+            # the row's entries: its flooded neighbours, then the diagonal
+            e = 0
+            diag = 0.0
+            if up and flooded[i - 1, j]:
+                row_cols[e], row_vals[e] = idx[i - 1, j], -gy[i - 1, j]
+                e += 1
+                diag += gy[i - 1, j]
+            elif up:
+                diag += mgy[i - 1, j]
+            if left and flooded[i, j - 1]:
+                row_cols[e], row_vals[e] = idx[i, j - 1], -gx[i, j - 1]
+                e += 1
+                diag += gx[i, j - 1]
+            elif left:
+                diag += mgx[i, j - 1]
+            if right:
+                diag += gx[i, j] if flooded[i, j + 1] else mgx[i, j]
+            if down:
+                diag += gy[i, j] if flooded[i + 1, j] else mgy[i, j]
+            if i == ny - 1:
+                diag += g_side[j]
+            if j == nx - 1:
+                diag += g_out[i]
+            if right and flooded[i, j + 1]:
+                row_cols[e], row_vals[e] = idx[i, j + 1], -gx[i, j]
+                e += 1
+            if down and flooded[i + 1, j]:
+                row_cols[e], row_vals[e] = idx[i + 1, j], -gy[i, j]
+                e += 1
+            row_cols[e], row_vals[e] = r, diag
             e += 1
-            diag += gy[i - 1, j]
-        elif up:
-            diag += mgy[i - 1, j]
-        if left and flooded[i, j - 1]:
-            row_cols[e], row_vals[e] = idx[i, j - 1], -gx[i, j - 1]
-            e += 1
-            diag += gx[i, j - 1]
-        elif left:
-            diag += mgx[i, j - 1]
-        if right:
-            diag += gx[i, j] if flooded[i, j + 1] else mgx[i, j]
-        if down:
-            diag += gy[i, j] if flooded[i + 1, j] else mgy[i, j]
-        if i == ny - 1:
-            diag += g_side[j]
-        if j == nx - 1:
-            diag += g_out[i]
-        if right and flooded[i, j + 1]:
-            row_cols[e], row_vals[e] = idx[i, j + 1], -gx[i, j]
-            e += 1
-        if down and flooded[i + 1, j]:
-            row_cols[e], row_vals[e] = idx[i + 1, j], -gy[i, j]
-            e += 1
-        row_cols[e], row_vals[e] = r, diag
-        e += 1
-        for t in range(1, e):               # five at most: insertion sort by column
-            col, val, q = row_cols[t], row_vals[t], t
-            while q > 0 and row_cols[q - 1] > col:
-                row_cols[q], row_vals[q] = row_cols[q - 1], row_vals[q - 1]
-                q -= 1
-            row_cols[q], row_vals[q] = col, val
-        for t in range(e):
-            data[k], indices[k] = row_vals[t], row_cols[t]
-            k += 1
-        indptr[r + 1] = k
+            for t in range(1, e):               # five at most: insertion sort by column
+                col, val, q = row_cols[t], row_vals[t], t
+                while q > 0 and row_cols[q - 1] > col:
+                    row_cols[q], row_vals[q] = row_cols[q - 1], row_vals[q - 1]
+                    q -= 1
+                row_cols[q], row_vals[q] = col, val
+            for t in range(e):
+                data[k], indices[k] = row_vals[t], row_cols[t]
+                k += 1
+            indptr[r + 1] = k
     return data[:k], indices[:k], indptr, rhs, by_column
 
 
@@ -202,14 +203,33 @@ def meniscus_faces(flooded, theta, h, factor, young_laplace, g, cavity, gas, p_c
 def edge_connected(gas, closed_side):
     """The cells of ``gas`` (bool, ny x nx) connected through other gas cells (4-neighbours)
     to the first and last columns and, unless ``closed_side``, the last row."""
+    return _grow(gas, closed_side, np.zeros(gas.shape, np.bool_))
+
+
+@njit(cache=True)
+def edge_connected_from(gas, closed_side, before):
+    """:func:`edge_connected` of ``gas`` given ``before``, that of a gas it holds (the open
+    cells before some flooded ones opened): grown from it, the same cells at a fraction of
+    the cost."""
+    return _grow(gas, closed_side, before.copy())
+
+
+@njit(cache=True)
+def _grow(gas, closed_side, out):
+    """``out`` (the cells known connected to the edges) grown, in place, by every gas cell
+    connected to the edges or to ``out`` through gas cells: seeded from the gas cells on
+    the edges or beside ``out``, flooded from there."""
     ny, nx = gas.shape
-    out = np.zeros((ny, nx), np.bool_)
     stack = np.empty(ny * nx, np.int64)
     top = 0
     for i in range(ny):
         for j in range(nx):
-            edge = j == 0 or j == nx - 1 or (i == ny - 1 and not closed_side)
-            if edge and gas[i, j] and not out[i, j]:
+            if not gas[i, j] or out[i, j]:
+                continue
+            seed = j == 0 or j == nx - 1 or (i == ny - 1 and not closed_side)
+            seed = seed or (i > 0 and out[i - 1, j]) or (i + 1 < ny and out[i + 1, j])
+            seed = seed or (j > 0 and out[i, j - 1]) or (j + 1 < nx and out[i, j + 1])
+            if seed:
                 out[i, j] = True
                 stack[top] = i * nx + j
                 top += 1
@@ -327,17 +347,27 @@ def _given(qx, qy, q_last, q_side, mx, my, outer):
 
 
 @njit(cache=True)
-def hold_back(qx, qy, q_last, q_side, q_supply, held, opn, draw_x, draw_y, layer, short_at):
-    """Cut back the fluxes out of open cells (``opn``) that would give more than they hold
-    (``held`` [m3/s] over the step; short below ``short_at``): first on the faces where the
-    flooded region draws on them (``draw_x`` / ``draw_y``), then, after the films the cells
+def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_x, draw_y,
+              layer, short):
+    """Cut back the fluxes out of open cells (neither ``flooded`` nor ``island``) that would
+    give more than they hold (their oil ``c`` [m] on cells of ``d`` [m] over the step ``dt``
+    [s]; short below ``short`` / dt [m3/s]): first on the faces where the flooded region
+    draws on them (``draw_x`` / ``draw_y``), then, after the films the cells
     behind a receding meniscus (``layer``) lay are drawn from the cell before them, on every
     face and through the outlet and the side. Each round scales every short cell's outgoing
     fluxes by what it can give, at most 100 rounds a pass. Returns the new qx, qy, q_last,
     q_side (:meth:`ehlfoam.thinfilm.operators.Operators.move`)."""
     qx, qy = qx.copy(), qy.copy()
     q_last, q_side = q_last.copy(), q_side.copy()
-    ny, nx = held.shape
+    ny, nx = c.shape
+    held = np.empty((ny, nx))              # [m3/s] over the step
+    short_at = np.empty((ny, nx))
+    opn = np.empty((ny, nx), np.bool_)
+    for i in range(ny):
+        for j in range(nx):
+            held[i, j] = c[i, j] * d * d / dt
+            short_at[i, j] = short[i, j] / dt
+            opn[i, j] = not flooded[i, j] and not island[i, j]
     all_x = np.ones(qx.shape, np.bool_)
     all_y = np.ones(qy.shape, np.bool_)
     for only_draws in (True, False):

@@ -96,12 +96,13 @@ class Operators:
             cavity = np.zeros(c.shape, dtype=bool)
         return fill(c, self.h, self.layers, cavity)
 
-    def cavities(self, flooded: np.ndarray) -> np.ndarray:
+    def cavities(self, flooded: np.ndarray, before: np.ndarray | None = None) -> np.ndarray:
         """The open cells whose gas the flooded region encloses, at the cavitation pressure
-        (:func:`ehlfoam.thinfilm.cavity.cavities`); none without one."""
+        (:func:`ehlfoam.thinfilm.cavity.cavities`; ``before``: the outer air of a flooded
+        set that held this one); none without one."""
         if self.p_cav is None:
             return np.zeros_like(flooded)
-        return cavities(flooded, self.island, self.closed_side)
+        return cavities(flooded, self.island, self.closed_side, before)
 
     def menisci(self, flooded: np.ndarray, c: np.ndarray,
                 cavity: np.ndarray | None = None,
@@ -161,8 +162,10 @@ class Operators:
         (:mod:`ehlfoam.thinfilm.gas`); None: at the cavitation pressure."""
         opened = np.zeros_like(flooded)
         cavitated = np.zeros_like(flooded)
+        outer = None        # the outer air of the last pass: each pass only opens cells
         for _ in range(1000):
-            cavity = self.cavities(flooded)
+            cavity = self.cavities(flooded, outer)
+            outer = ~flooded & ~self.island & ~cavity
             faces = self.menisci(flooded, c, cavity,
                                  None if gas is None or not cavity.any() else gas(cavity))
             p = self.pressure(flooded, c, dt, faces)
@@ -203,11 +206,9 @@ class Operators:
         q_side = np.where(flooded[-1], self.g_side * p[-1], 0.0)
         q_last = np.where(flooded[:, -1], self.cx_out + self.g_out * p[:, -1],
                           u * c[:, -1] * d)
-        held = c * d * d / dt                          # [m3/s] over the step
-        opn = ~flooded & ~self.island
         qx, qy, q_last, q_side = hold_back(
             qx, qy, np.asarray(q_last, dtype=float), np.asarray(q_side, dtype=float),
-            self.q_supply, held, opn, draw_x, draw_y, layer, self._short / dt)
+            self.q_supply, c, d, dt, flooded, self.island, draw_x, draw_y, layer, self._short)
         net = net_inflow(qx, qy, q_last, q_side, self.q_supply)
         out = net * dt / (d * d), float(q_last.sum()), float(q_side.sum())
         return (*out, q_last) if by_row else out
