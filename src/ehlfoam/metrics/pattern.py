@@ -216,14 +216,15 @@ def _bubble_mask(r: Raster, labels: np.ndarray, count: int) -> np.ndarray:
     return _touching(labels, count, r.rim & (np.broadcast_to(r.x, r.island.shape) > 0.0))
 
 
-def _bubble(r: Raster, outer: np.ndarray, bubble: np.ndarray,
+def _bubble(r: Raster, outer: np.ndarray, bubble: np.ndarray, oil: np.ndarray,
             threshold: float) -> dict[str, Any]:
-    """Bubble metrics (see :func:`flow_pattern`) of the ``bubble`` pixels."""
+    """Bubble metrics (see :func:`flow_pattern`) of the ``bubble`` pixels (``oil``: the oil
+    pixels; the extents read alpha only on the bubble and the oil, never the island's NaN)."""
     a = r.geom.a
     if not bubble.any():
         return {"bubble_length_over_a": 0.0, "bubble_width_over_a": 0.0,
                 "bubble_enclosed": False}
-    alpha, oil = np.nan_to_num(r.alpha, nan=1.0), r.oil(threshold)
+    alpha = r.alpha
     _, tip = _extent(bubble, alpha, oil, r.x, threshold)
     y_lo, y_hi = _extent(bubble.T, alpha.T, oil.T, r.y, threshold)
     return {"bubble_length_over_a": max(0.0, float((tip - a) / a)),
@@ -289,7 +290,7 @@ def pattern_and_bubble(r: Raster, threshold: float = 0.5) -> tuple[dict[str, Any
 
     length = width = x_lo = x_hi = clearance = nearest = None
     if flooded.any():
-        alpha = np.nan_to_num(r.alpha, nan=0.0)
+        alpha = r.alpha             # read on the region and the gas only: no NaN
         x_lo, x_hi = _extent(flooded, alpha, gas, r.x, threshold)
         y_lo, y_hi = _extent(flooded.T, alpha.T, gas.T, r.y, threshold)
         length, width = float((x_hi - x_lo) / a), float((y_hi - y_lo) / a)
@@ -322,7 +323,7 @@ def pattern_and_bubble(r: Raster, threshold: float = 0.5) -> tuple[dict[str, Any
         "wake_open": wake_open,
         "inlet_starved": inlet_starved,
         "enclosed_bubbles": enclosed,
-        **_bubble(r, outer, bubble, threshold),
+        **_bubble(r, outer, bubble, oil, threshold),
         "oil_area_fraction": float(oil.sum() / free.sum()),
         "mean_alpha": float(np.nanmean(r.alpha[free])),
     }, bubble)

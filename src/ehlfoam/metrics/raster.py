@@ -108,11 +108,11 @@ class Raster:
 
     def oil(self, threshold: float = 0.5) -> np.ndarray:
         """Oil pixels: ``alpha >= threshold`` outside the island."""
-        return ~self.island & (np.nan_to_num(self.alpha, nan=0.0) >= threshold)
+        return ~self.island & (self.alpha >= threshold)      # NaN: neither oil nor gas
 
     def gas(self, threshold: float = 0.5) -> np.ndarray:
         """Gas pixels: ``alpha < threshold`` outside the island."""
-        return ~self.island & (np.nan_to_num(self.alpha, nan=1.0) < threshold)
+        return ~self.island & (self.alpha < threshold)
 
 
 # --------------------------------------------------------------------------

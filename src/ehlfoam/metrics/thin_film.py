@@ -12,6 +12,8 @@ centres), and the pattern is read off that raster. SI inside; lengths out as rat
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy import ndimage
 from scipy.sparse import csr_matrix
@@ -44,6 +46,18 @@ def _linear_weights(src: np.ndarray, dst: np.ndarray) -> csr_matrix:
                       shape=(len(dst), len(src)))
 
 
+@functools.lru_cache(maxsize=8)
+def _pixels(geom: Geometry, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The raster's pixel centres x, y [m] and its island (read-only): the same at every
+    reading of a run."""
+    xs, ys = _grid(geom, cell)
+    X, Y = np.meshgrid(xs, ys)
+    island = X**2 + Y**2 <= geom.island_radius**2
+    for arr in (xs, ys, island):
+        arr.flags.writeable = False
+    return xs, ys, island
+
+
 def thin_film_raster(sol: ThinFilmSolution, geom: Geometry,
                      cell: float | None = None) -> Raster:
     """The state's mid-gap oil fraction on the metrics' raster of ``geom`` (a half domain,
@@ -52,14 +66,13 @@ def thin_film_raster(sol: ThinFilmSolution, geom: Geometry,
     grid = sol.grid
     alpha = _outside_island(np.nan_to_num(sol.mid_gap_alpha()), grid.island)
     y = np.concatenate([-grid.y[::-1], grid.y])
-    xs, ys = _grid(geom, float(cell if cell is not None else DEFAULT_CELL_OVER_A * geom.a))
+    xs, ys, island = _pixels(geom, float(cell if cell is not None
+                                         else DEFAULT_CELL_OVER_A * geom.a))
     # bilinear on the regular grid, as two sparse one-dimensional linear maps (a small
     # share of a point-by-point interpolator's cost: the run reads its oil a few times a transit)
     wy = _linear_weights(y, np.clip(ys, y[0], y[-1]))
     wx = _linear_weights(grid.x, np.clip(xs, grid.x[0], grid.x[-1]))
     values = np.clip(np.asarray(wy @ np.vstack([alpha[::-1], alpha]) @ wx.T), 0, 1)
-    X, Y = np.meshgrid(xs, ys)
-    island = X**2 + Y**2 <= geom.island_radius**2
     values[island] = np.nan
     return Raster(x=xs, y=ys, alpha=values, island=island, geom=geom)
 
