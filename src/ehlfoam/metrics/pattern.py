@@ -83,9 +83,9 @@ def _touching(labels: np.ndarray, count: int, where: np.ndarray) -> np.ndarray:
 def _outer_air(labels: np.ndarray, count: int) -> tuple[np.ndarray, int]:
     """(gas connected to the domain edge, number of enclosed gas regions), from the gas's
     regions (4-connected, ``labels`` 1..``count``)."""
-    outer = _touching(labels, count, _edge_mask(labels.shape))
-    edge_regions = np.unique(labels[_edge_mask(labels.shape)])
-    return outer, int(count - np.count_nonzero(edge_regions))
+    edge = _edge_mask(labels.shape)
+    edge_regions = np.count_nonzero(np.unique(labels[edge]))
+    return _touching(labels, count, edge), int(count - edge_regions)
 
 
 def _flooded(oil: np.ndarray, rim: np.ndarray) -> np.ndarray:
@@ -417,7 +417,7 @@ def flooded_widths_at(r: Raster, x_stations: Any, threshold: float = 0.5) -> lis
         raise ValueError(f"r: must be a Raster, got {type(r).__name__}")
     oil, gas = r.oil(threshold), r.gas(threshold)
     flooded = _flooded(oil, r.rim)
-    alpha = np.nan_to_num(r.alpha, nan=0.0)
+    alpha = r.alpha             # read on the region and the gas only: no NaN
     widths: list[float | None] = []
     for x in np.atleast_1d(np.asarray(x_stations, float)):
         j = int(np.argmin(np.abs(r.x - x)))
