@@ -16,9 +16,10 @@ outlet's counterpart), started from the point's thin-film balance, capped at ``-
 wall time and 6 transits. The reference of a point is the finest rung (the last of
 ``--rungs``) that came to rest (``steady``). Per metric (state, inlet meniscus, flooded
 width, bubble or wake length, oil held) each rung's error against it: the state right or
-wrong, the others relative. Cost: the CPU time of the run (the process's own, the thin-film
-start included, plus the OpenFOAM solver's on every rank), the EHL precalc excluded (solved
-first, cached). Prints a row per point and rung and a summary per rung (error, median CPU, CPU
+wrong, the others relative, each metric the run's mean over its last transit (a single
+write carries the menisci's jitter; the last write's where the state changed within it).
+Cost: the CPU time of the run (the process's own, the thin-film start included, plus the
+OpenFOAM solver's on every rank), the EHL precalc excluded (solved first, cached). Prints a row per point and rung and a summary per rung (error, median CPU, CPU
 against the reference's); ``--charts DIR`` draws one chart per metric, error against CPU
 (log axis), a marker per rung. ``--quick``: two points on the two cheapest thin-film levels
 over a small domain (seconds).
@@ -38,6 +39,7 @@ from common import (add_output_options, count_option, print_table, solver_cpu_s,
 from ehlfoam.case.writer import write_case
 from ehlfoam.errors import SpecError
 from ehlfoam.gap.source import precalc_dir
+from ehlfoam.metrics.convergence import window_mean
 from ehlfoam.run.monitor import run_case
 from ehlfoam.seed.follow import write_started_case
 from ehlfoam.spec.case import CaseSpec, make_case_spec
@@ -92,8 +94,23 @@ def run_point(label: str, rung: str, spec: CaseSpec, case: Path) -> dict:
     row = {"point": label, "rung": rung, "cpu_s": cpu, "wall_s": time.perf_counter() - t0,
            "end_reason": m.get("end_reason"), "steady": bool(m.get("steady")),
            "state": m.get("state")}
-    row.update({name: m.get(key) for name, key in METRICS.items()})
+    row.update(last_transit_metrics(case, m))
     return row
+
+
+def last_transit_metrics(case: Path, last_write: dict) -> dict:
+    """Each metric of a run case: its mean over the writes of the last transit, and its
+    jitter there (``jitter_<metric>``, the standard deviation), as a single write carries
+    the menisci's write-to-write jitter (up to 0.2 a on the 3D levels); the last write's
+    (``last_write``: metrics.json) where the state changed within that transit, which makes
+    the bubble's mean meaningless. ``writes_averaged``: 1 there."""
+    w = window_mean(case, keys=tuple(METRICS.values()))
+    if w is None or len(w["states"]) != 1:
+        return {name: last_write.get(key) for name, key in METRICS.items()} | {
+            "writes_averaged": 1}
+    return ({name: w[key] for name, key in METRICS.items()}
+            | {f"jitter_{name}": w["jitter"][key] for name, key in METRICS.items()}
+            | {"writes_averaged": w["writes_averaged"]})
 
 
 def run_all(specs: list[tuple], jobs: int, work: Path) -> list[dict]:

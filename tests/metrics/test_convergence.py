@@ -103,6 +103,11 @@ def test_a_window_averages_out_a_meniscus_that_jumps_write_by_write(tmp_path):
     assert last["writes_averaged"] == 11 and last["time_s"] == pytest.approx(0.6)
     assert last == window_mean(case, None, 1.0)
     assert last["flooded_width_over_a"] == pytest.approx(12.55)
+    assert last["states"] == ["I"]
+    inlet = window_mean(case, 0.3, 0.5, keys=("inlet_meniscus_distance_over_a",))
+    assert set(inlet) - {"time_s", "state", "states", "writes_averaged", "jitter"} == {
+        "inlet_meniscus_distance_over_a"}
+    assert inlet["jitter"] == {"inlet_meniscus_distance_over_a": pytest.approx(0.5)}
 
 
 def _relaxing(t: np.ndarray, start: float, rest: float = 15.07, tau: float = 0.23) -> np.ndarray:

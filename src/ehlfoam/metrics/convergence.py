@@ -94,11 +94,11 @@ def history_number(value: str | None) -> float | None:
     return None if value in (None, "", "None") else float(value)
 
 
-def jitter(rows: list[dict]) -> dict[str, float]:
-    """Per metric, the standard deviation over history.csv ``rows`` (0 for fewer than two
-    values)."""
+def jitter(rows: list[dict], keys: tuple[str, ...] = METRICS) -> dict[str, float]:
+    """Per metric (``keys``: history.csv columns), the standard deviation over history.csv
+    ``rows`` (0 for fewer than two values)."""
     out = {}
-    for k in METRICS:
+    for k in keys:
         vals = np.array([v for r in rows if (v := history_number(r.get(k))) is not None])
         out[k] = float(vals.std()) if vals.size > 1 else 0.0
     return out
@@ -113,12 +113,14 @@ def read_history_rows(case: Path) -> list[dict]:
         return list(csv.DictReader(fh))
 
 
-def window_mean(case: Path, t_end: float | None = None, span: float = 1.0) -> dict | None:
-    """Each metric's mean over the writes of history.csv within ``span`` transits up to
-    ``t_end`` [s] (default: the last write; one write alone carries the meniscus's
-    cell-to-cell jitter and, on a resolved inlet, the drops that merge into it), that jitter,
-    the time [s] and state of the window's last write and the writes averaged; None without a
-    history or without a write in the window."""
+def window_mean(case: Path, t_end: float | None = None, span: float = 1.0,
+                keys: tuple[str, ...] = METRICS) -> dict | None:
+    """Each metric's mean (``keys``: history.csv columns) over the writes of history.csv
+    within ``span`` transits up to ``t_end`` [s] (default: the last write; one write alone
+    carries the meniscus's cell-to-cell jitter and, on a resolved inlet, the drops that merge
+    into it), that jitter, the time [s] and state of the window's last write, the states the
+    window saw (sorted) and the writes averaged; None without a history or without a write in
+    the window."""
     rows = read_history_rows(case)
     if t_end is not None:
         rows = [r for r in rows if float(r["time_s"]) <= t_end * (1 + 1e-9)]
@@ -128,11 +130,12 @@ def window_mean(case: Path, t_end: float | None = None, span: float = 1.0) -> di
     last = [r for r in rows
             if float(r["time_s"]) >= t_last - span * load_geometry(case).transit_time]
     means = {}
-    for k in METRICS:
+    for k in keys:
         vals = [v for r in last if (v := history_number(r.get(k))) is not None]
         means[k] = sum(vals) / len(vals) if vals else None
-    return means | {"time_s": t_last, "state": rows[-1]["state"], "writes_averaged": len(last),
-                    "jitter": jitter(last)}
+    return means | {"time_s": t_last, "state": rows[-1]["state"],
+                    "states": sorted({r["state"] for r in last}), "writes_averaged": len(last),
+                    "jitter": jitter(last, keys)}
 
 
 def last_transit(case: Path) -> dict | None:
