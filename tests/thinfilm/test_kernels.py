@@ -86,6 +86,34 @@ def test_the_pressure_is_the_same_by_band_or_by_sparse_lu(monkeypatch):
     assert np.max(np.abs(banded[flooded] - by_lu[flooded])) <= 1e-12 * scale
 
 
+def test_the_outer_air_is_the_gas_that_touches_the_open_edges_also_around_a_compact_region():
+    """The outer air as scipy's labelling finds it: the 4-connected gas regions that touch
+    the first or last column or (unless closed) the last row, on grids whose other cells
+    form a compact region with holes (a bounding box well inside the grid, on an edge, or
+    the whole grid), as the flood fill fills only that box."""
+    from ehlfoam.thinfilm.kernels import edge_connected
+    from scipy import ndimage
+
+    rng = np.random.default_rng(11)
+    enclosed = 0
+    for k in range(300):
+        closed = bool(k % 2)
+        ny, nx = rng.integers(3, 30), rng.integers(3, 40)
+        solid = np.zeros((ny, nx), bool)
+        a, b = sorted(rng.integers(0, ny, 2)), sorted(rng.integers(0, nx, 2))
+        solid[a[0]:a[1] + 1, b[0]:b[1] + 1] = rng.random((a[1] - a[0] + 1, b[1] - b[0] + 1)) < 0.7
+        gas = ~solid
+        labels, _ = ndimage.label(gas)
+        edges = np.zeros_like(gas)
+        edges[:, 0] = edges[:, -1] = True
+        edges[-1, :] |= not closed
+        touching = np.unique(labels[edges & gas])
+        expected = np.isin(labels, touching[touching > 0]) & gas
+        assert (edge_connected(gas, closed) == expected).all()
+        enclosed += int((gas & ~expected).any())
+    assert enclosed > 20                  # holes the region encloses: cavities, not air
+
+
 def test_the_outer_air_grown_from_a_smaller_gas_is_the_outer_air_found_anew():
     """Opening flooded cells only adds gas: the outer air grown from the one before (the
     step's second and later passes) is the one a flood fill from the edges finds, with a

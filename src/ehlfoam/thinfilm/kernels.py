@@ -17,21 +17,41 @@ _BIG = float(np.finfo(np.float64).max)     # np.nan_to_num's stand-in for inf
 
 
 @njit(cache=True)
-def _numbering(flooded, by_column):
-    """The flooded cells' numbers, row by row (x fastest) or column by column (y fastest),
-    -1 elsewhere, and the half-bandwidth that numbering gives the system (the largest
-    difference between 4-neighbours' numbers)."""
+def _bounds(flooded):
+    """The first and last rows and columns that hold a flooded cell, ``(i0, i1, j0, j1)``
+    (inclusive; ``(0, -1, 0, -1)``, empty ranges, without one): the region's bounding box,
+    outside which the menisci and the pressure system have nothing to do."""
     ny, nx = flooded.shape
-    idx = np.full((ny, nx), -1, np.int64)
-    n = 0
-    for k in range(ny * nx):
-        i, j = (k % ny, k // ny) if by_column else (k // nx, k % nx)
-        if flooded[i, j]:
-            idx[i, j] = n
-            n += 1
-    band = 0
+    i0, i1, j0, j1 = ny, -1, nx, -1
     for i in range(ny):
         for j in range(nx):
+            if flooded[i, j]:
+                i0, i1 = min(i0, i), max(i1, i)
+                j0, j1 = min(j0, j), max(j1, j)
+    if i1 < 0:
+        return 0, -1, 0, -1
+    return i0, i1, j0, j1
+
+
+@njit(cache=True)
+def _numbering(flooded, by_column, bounds):
+    """The flooded cells' numbers, row by row (x fastest) or column by column (y fastest),
+    -1 elsewhere, and the half-bandwidth that numbering gives the system (the largest
+    difference between 4-neighbours' numbers); ``bounds``: the flooded cells' bounding box
+    (:func:`_bounds`)."""
+    ny, nx = flooded.shape
+    i0, i1, j0, j1 = bounds
+    idx = np.full((ny, nx), -1, np.int64)
+    n = 0
+    for outer in range(j0, j1 + 1) if by_column else range(i0, i1 + 1):
+        for inner in range(i0, i1 + 1) if by_column else range(j0, j1 + 1):
+            i, j = (inner, outer) if by_column else (outer, inner)
+            if flooded[i, j]:
+                idx[i, j] = n
+                n += 1
+    band = 0
+    for i in range(i0, i1 + 1):
+        for j in range(j0, j1 + 1):
             if idx[i, j] >= 0 and i + 1 < ny and idx[i + 1, j] >= 0:
                 band = max(band, idx[i + 1, j] - idx[i, j])
             if idx[i, j] >= 0 and j + 1 < nx and idx[i, j + 1] >= 0:
@@ -52,8 +72,10 @@ def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_s
     the supply into the first column, the side row's and the last column's outflow
     conductances and the outlet's Couette flux."""
     ny, nx = flooded.shape
-    idx, n, band_rows = _numbering(flooded, False)
-    idx_c, _, band_columns = _numbering(flooded, True)
+    bounds = _bounds(flooded)
+    i0, i1, j0, j1 = bounds
+    idx, n, band_rows = _numbering(flooded, False, bounds)
+    idx_c, _, band_columns = _numbering(flooded, True, bounds)
     by_column = band_columns < band_rows
     if by_column:
         idx = idx_c
@@ -64,8 +86,8 @@ def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_s
     row_cols = np.empty(5, np.int64)
     row_vals = np.empty(5)
     k = 0
-    for outer in range(nx if by_column else ny):     # y fastest by column, x by row
-        for inner in range(ny if by_column else nx):
+    for outer in range(j0, j1 + 1) if by_column else range(i0, i1 + 1):   # y fastest by
+        for inner in range(i0, i1 + 1) if by_column else range(j0, j1 + 1):  # column, x by row
             i, j = (inner, outer) if by_column else (outer, inner)
             r = idx[i, j]
             if r < 0:
@@ -164,14 +186,20 @@ def meniscus_faces(flooded, theta, h, factor, young_laplace, g, cavity, gas, p_c
     meniscus's pressure [Pa] and the gap there [m], as
     :meth:`ehlfoam.thinfilm.operators.Operators.menisci` defines them (``factor``: the
     dynamic menisci's factor on every cell; ``gas``: every cell's gas pressure, gauge [Pa],
-    NaN off the cavities, used when ``has_gas``; ``p_cav`` when ``has_cav``)."""
+    NaN off the cavities, used when ``has_gas``; ``p_cav`` when ``has_cav``); 0 outside the
+    flooded cells' bounding box, where no face has a flooded side to read them."""
     ny, nx = flooded.shape
     fy, fx = (ny, nx - 1) if axis == 1 else (ny - 1, nx)
-    g_m = np.empty((fy, fx))
-    p_m = np.empty((fy, fx))
-    h_m = np.empty((fy, fx))
-    for i in range(fy):
-        for j in range(fx):
+    g_m = np.zeros((fy, fx))
+    p_m = np.zeros((fy, fx))
+    h_m = np.zeros((fy, fx))
+    i0, i1, j0, j1 = _bounds(flooded)        # the faces with a flooded side, and 0 elsewhere
+    if axis == 1:
+        j0, j1 = max(j0 - 1, 0), min(j1, fx - 1)
+    else:
+        i0, i1 = max(i0 - 1, 0), min(i1, fy - 1)
+    for i in range(i0, i1 + 1):
+        for j in range(j0, j1 + 1):
             i2, j2 = (i, j + 1) if axis == 1 else (i + 1, j)
             hi_open = flooded[i, j] and not flooded[i2, j2]
             if hi_open:     # the flooded cell lo, the meniscus in hi
@@ -202,8 +230,24 @@ def meniscus_faces(flooded, theta, h, factor, young_laplace, g, cavity, gas, p_c
 @njit(cache=True)
 def edge_connected(gas, closed_side):
     """The cells of ``gas`` (bool, ny x nx) connected through other gas cells (4-neighbours)
-    to the first and last columns and, unless ``closed_side``, the last row."""
-    return _grow(gas, closed_side, np.zeros(gas.shape, np.bool_))
+    to the first and last columns and, unless ``closed_side``, the last row.
+
+    Outside the bounding box of the other cells every cell is gas, connected to the first
+    or last column through that outside (its rows above and below the box span the grid,
+    its columns beside it reach the first or last column): those are taken as connected at
+    once and only the box is flood filled, from its open edges and from beside its
+    outside."""
+    ny, nx = gas.shape
+    i0, i1, j0, j1 = _bounds(np.logical_not(gas))
+    out = np.zeros(gas.shape, np.bool_)
+    if i1 < 0:                                  # all gas
+        out[:, :] = True
+        return out
+    for i in range(ny):
+        for j in range(nx):
+            if i < i0 or i > i1 or j < j0 or j > j1:
+                out[i, j] = True
+    return _grow(gas, closed_side, out)
 
 
 @njit(cache=True)
