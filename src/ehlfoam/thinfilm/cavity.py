@@ -32,7 +32,7 @@ import numpy as np
 
 from ehlfoam.thinfilm.kernels import edge_connected, edge_connected_from
 
-__all__ = ["cavities", "outer_air"]
+__all__ = ["cavities", "cavities_and_outer_air", "outer_air"]
 
 
 def outer_air(gas: np.ndarray, closed_side: bool = False,
@@ -53,5 +53,13 @@ def cavities(flooded: np.ndarray, island: np.ndarray, closed_side: bool = False,
     """The open cells whose gas the flooded region encloses (bool, ny x nx): not flooded, not
     island, and not connected to the outer air (:func:`outer_air`; ``before``: the outer
     air of a flooded set that held this one)."""
+    return cavities_and_outer_air(flooded, island, closed_side, before)[0]
+
+
+def cavities_and_outer_air(flooded: np.ndarray, island: np.ndarray, closed_side: bool = False,
+                           before: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`cavities` and the outer air they were told from (:func:`outer_air`): the
+    open cells are the two together."""
     gas = ~flooded & ~island
-    return gas & ~outer_air(gas, closed_side, before)
+    outer = outer_air(gas, closed_side, before)
+    return gas & ~outer, outer

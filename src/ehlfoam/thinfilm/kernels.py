@@ -161,6 +161,40 @@ def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_s
 
 
 @njit(cache=True)
+def pressure_on_grid(flooded, x, by_column):
+    """The flooded cells' pressures ``x`` (numbered as :func:`pressure_system` numbers them:
+    column by column where ``by_column``, else row by row) on the grid, NaN elsewhere."""
+    ny, nx = flooded.shape
+    i0, i1, j0, j1 = _bounds(flooded)
+    p = np.full((ny, nx), np.nan)
+    n = 0
+    for outer in range(j0, j1 + 1) if by_column else range(i0, i1 + 1):
+        for inner in range(i0, i1 + 1) if by_column else range(j0, j1 + 1):
+            i, j = (inner, outer) if by_column else (outer, inner)
+            if flooded[i, j]:
+                p[i, j] = x[n]
+                n += 1
+    return p
+
+
+@njit(cache=True)
+def advance_oil(c, dc, h, opened, cavitated, island):
+    """Every cell's oil after a step, ``c + dc`` [m], and the cells flooded then: full to
+    their gap ``h`` (within 1e-9 of it), not opened within the step (``opened``,
+    ``cavitated``), not ``island`` (:meth:`ehlfoam.thinfilm.march.March._advance`)."""
+    ny, nx = c.shape
+    c_new = np.empty((ny, nx))
+    flooded = np.empty((ny, nx), np.bool_)
+    for i in range(ny):
+        for j in range(nx):
+            v = c[i, j] + dc[i, j]
+            c_new[i, j] = v
+            flooded[i, j] = (v >= h[i, j] * (1.0 - 1e-9) and not opened[i, j]
+                             and not cavitated[i, j] and not island[i, j])
+    return c_new, flooded
+
+
+@njit(cache=True)
 def fill(c, h, layers, cavity):
     """How far into each cell a meniscus beside it reaches, 0-1
     (:meth:`ehlfoam.thinfilm.operators.Operators.fill`): the bulk oil ``c - layers`` over
@@ -400,7 +434,8 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
     behind a receding meniscus (``layer``) lay are drawn from the cell before them, on every
     face and through the outlet and the side. Each round scales every short cell's outgoing
     fluxes by what it can give, at most 100 rounds a pass. Returns the new qx, qy, q_last,
-    q_side (:meth:`ehlfoam.thinfilm.operators.Operators.move`)."""
+    q_side and every cell's net inflow with them [m3/s] (:func:`net_inflow`;
+    :meth:`ehlfoam.thinfilm.operators.Operators.move`)."""
     qx, qy = qx.copy(), qy.copy()
     q_last, q_side = q_last.copy(), q_side.copy()
     ny, nx = c.shape
@@ -414,6 +449,8 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
             opn[i, j] = not flooded[i, j] and not island[i, j]
     all_x = np.ones(qx.shape, np.bool_)
     all_y = np.ones(qy.shape, np.bool_)
+    net = np.empty((ny, nx))
+    fresh = False
     for only_draws in (True, False):
         mx = draw_x if only_draws else all_x
         my = draw_y if only_draws else all_y
@@ -423,14 +460,17 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
                 for j in range(1, nx):
                     if layer[i, j] and opn[i, j]:
                         qx[i, j - 1] += max(-(held[i, j] + net[i, j]), 0.0)
+        fresh = False                       # net is that of the fluxes now
         for _ in range(100):
             net = net_inflow(qx, qy, q_last, q_side, q_supply)
-            short = opn & (held + net < short_at)
-            if not short.any():
+            short, any_short = _short(opn, held, net, short_at)
+            if not any_short:
+                fresh = True
                 break
             give = _given(qx, qy, q_last, q_side, mx, my, not only_draws)
             short = short & (give > 0)
             if not short.any():
+                fresh = True
                 break
             scale = np.ones((ny, nx))
             for i in range(ny):
@@ -451,7 +491,24 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
                     q_last[i] *= scale[i, nx - 1]
                 for j in range(nx):
                     q_side[j] *= scale[ny - 1, j]
-    return qx, qy, q_last, q_side
+    if not fresh:
+        net = net_inflow(qx, qy, q_last, q_side, q_supply)
+    return qx, qy, q_last, q_side, net
+
+
+@njit(cache=True)
+def _short(opn, held, net, short_at):
+    """The open cells whose oil ``held`` plus ``net`` inflow falls below ``short_at`` (all
+    [m3/s] over the step), and whether there is one."""
+    ny, nx = opn.shape
+    short = np.zeros((ny, nx), np.bool_)
+    found = False
+    for i in range(ny):
+        for j in range(nx):
+            if opn[i, j] and held[i, j] + net[i, j] < short_at[i, j]:
+                short[i, j] = True
+                found = True
+    return short, found
 
 
 @njit(cache=True)

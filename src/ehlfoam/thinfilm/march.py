@@ -73,6 +73,7 @@ from dataclasses import replace
 import numpy as np
 
 from ehlfoam.thinfilm.gas import CavityGas
+from ehlfoam.thinfilm.kernels import advance_oil
 from ehlfoam.thinfilm.operators import Operators, Step
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 from ehlfoam.thinfilm.solution import (ThinFilmSolution, connected_region, gas_on,
@@ -225,9 +226,8 @@ class Marcher:
         """Move the oil and the gas by the solved step ``s`` of ``dt`` [s] and book it."""
         gas = self.gas
         c_old, flooded_old = self.c, self.flooded
-        self.c = self.c + s.dc
-        self.flooded = ((self.c >= self.h * (1.0 - 1e-9)) & ~s.opened & ~s.cavitated
-                        & ~self.grid.island)
+        self.c, self.flooded = advance_oil(self.c, s.dc, self.h, s.opened, s.cavitated,
+                                           self.grid.island)
         if gas is not None:
             new = self.cavity()
             outer = ~self.flooded & ~self.grid.island & ~new

@@ -13,9 +13,10 @@ from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
-from ehlfoam.thinfilm.cavity import cavities
+from ehlfoam.thinfilm.cavity import cavities_and_outer_air
 from ehlfoam.thinfilm.kernels import (band_cholesky_solve, face_fluxes, fill, hold_back,
-                                      meniscus_faces, net_inflow, pressure_system)
+                                      meniscus_faces, pressure_on_grid,
+                                      pressure_system)
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
@@ -100,9 +101,15 @@ class Operators:
         """The open cells whose gas the flooded region encloses, at the cavitation pressure
         (:func:`ehlfoam.thinfilm.cavity.cavities`; ``before``: the outer air of a flooded
         set that held this one); none without one."""
+        return self._open_cells(flooded, before)[0]
+
+    def _open_cells(self, flooded: np.ndarray,
+                    before: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+        """:meth:`cavities` and the outer air they were told from (None without a
+        cavitation pressure)."""
         if self.p_cav is None:
-            return np.zeros_like(flooded)
-        return cavities(flooded, self.island, self.closed_side, before)
+            return np.zeros_like(flooded), None
+        return cavities_and_outer_air(flooded, self.island, self.closed_side, before)
 
     def menisci(self, flooded: np.ndarray, c: np.ndarray,
                 cavity: np.ndarray | None = None,
@@ -137,18 +144,12 @@ class Operators:
                  faces: "_Faces") -> np.ndarray:
         """p on the flooded cells, the menisci at ``faces``' pressures: each flooded cell's
         outflow is what it holds beyond its gap / dt."""
-        p = np.full(flooded.shape, np.nan)
         if not flooded.any():
-            return p
+            return np.full(flooded.shape, np.nan)
         data, indices, indptr, rhs, by_column = pressure_system(
             flooded, c, self.h, self.d, dt, self.u, self.gx, self.gy, self.cx, faces.gx,
             faces.gy, faces.px, faces.py, self.q_supply, self.g_side, self.g_out, self.cx_out)
-        x = _solve(data, indices, indptr, rhs)
-        if by_column:
-            p.T[flooded.T] = x
-        else:
-            p[flooded] = x
-        return p
+        return pressure_on_grid(flooded, _solve(data, indices, indptr, rhs), by_column)
 
     def step(self, flooded: np.ndarray, c: np.ndarray, dt: float,
              gas: Callable[[np.ndarray], np.ndarray] | None = None) -> "Step":
@@ -164,8 +165,7 @@ class Operators:
         cavitated = np.zeros_like(flooded)
         outer = None        # the outer air of the last pass: each pass only opens cells
         for _ in range(1000):
-            cavity = self.cavities(flooded, outer)
-            outer = ~flooded & ~self.island & ~cavity
+            cavity, outer = self._open_cells(flooded, outer)
             faces = self.menisci(flooded, c, cavity,
                                  None if gas is None or not cavity.any() else gas(cavity))
             p = self.pressure(flooded, c, dt, faces)
@@ -206,10 +206,9 @@ class Operators:
         q_side = np.where(flooded[-1], self.g_side * p[-1], 0.0)
         q_last = np.where(flooded[:, -1], self.cx_out + self.g_out * p[:, -1],
                           u * c[:, -1] * d)
-        qx, qy, q_last, q_side = hold_back(
+        qx, qy, q_last, q_side, net = hold_back(
             qx, qy, np.asarray(q_last, dtype=float), np.asarray(q_side, dtype=float),
             self.q_supply, c, d, dt, flooded, self.island, draw_x, draw_y, layer, self._short)
-        net = net_inflow(qx, qy, q_last, q_side, self.q_supply)
         out = net * dt / (d * d), float(q_last.sum()), float(q_side.sum())
         return (*out, q_last) if by_row else out
 
