@@ -5,7 +5,9 @@ to what it holds. Each does what the array expressions it replaced did
 (:mod:`ehlfoam.thinfilm.operators`, :mod:`ehlfoam.thinfilm.cavity`), in one pass over the
 grid and in the same order of additions: bitwise the same but for the pressure solve. A step
 of the medium level (5,000 cells) made some thirty whole-array temporaries for each of them.
-Arrays are indexed ``[row, column]``: rows across the track (y), columns along the rolling
+The menisci, the pressure system and the outer air's flood fill visit only the bounding box
+of the flooded (or, for the fill, the non-gas) cells: outside it there is nothing for them
+to do. Arrays are indexed ``[row, column]``: rows across the track (y), columns along the rolling
 direction (x)."""
 
 from __future__ import annotations
