@@ -1,14 +1,13 @@
-"""The thin-film step's hot loops as numba kernels: the flooded cells' pressure system and
-its banded Cholesky solve, the menisci on the faces between flooded and open cells, the open
-cells connected to the domain's open edges, and the rounds that hold an open cell's outflow
-to what it holds. Each does what the array expressions it replaced did
-(:mod:`ehlfoam.thinfilm.operators`, :mod:`ehlfoam.thinfilm.cavity`), in one pass over the
-grid and in the same order of additions: bitwise the same but for the pressure solve. A step
-of the medium level (5,000 cells) made some thirty whole-array temporaries for each of them.
-The menisci, the pressure system and the outer air's flood fill visit only the bounding box
-of the flooded (or, for the fill, the non-gas) cells: outside it there is nothing for them
-to do. Arrays are indexed ``[row, column]``: rows across the track (y), columns along the rolling
-direction (x)."""
+"""The thin-film step's pressure side as numba kernels: the flooded cells' pressure system
+and its banded Cholesky solve, the pressure put back on the grid, the menisci on the faces
+between flooded and open cells and the fill that places them, and the open cells connected
+to the domain's open edges (the oil's moves: :mod:`ehlfoam.thinfilm.flux_kernels`). Each
+does what the array expressions it replaced did (:mod:`ehlfoam.thinfilm.operators`,
+:mod:`ehlfoam.thinfilm.cavity`), in the same order of additions: bitwise the same but for
+the pressure solve. The menisci, the pressure system and the outer air's flood fill visit
+only the bounding box of the flooded (or, for the fill, the non-gas) cells: outside it there
+is nothing for them to do. Arrays are indexed ``[row, column]``: rows across the track (y),
+columns along the rolling direction (x)."""
 
 from __future__ import annotations
 
@@ -177,23 +176,6 @@ def pressure_on_grid(flooded, x, by_column):
                 p[i, j] = x[n]
                 n += 1
     return p
-
-
-@njit(cache=True)
-def advance_oil(c, dc, h, opened, cavitated, island):
-    """Every cell's oil after a step, ``c + dc`` [m], and the cells flooded then: full to
-    their gap ``h`` (within 1e-9 of it), not opened within the step (``opened``,
-    ``cavitated``), not ``island`` (:meth:`ehlfoam.thinfilm.march.March._advance`)."""
-    ny, nx = c.shape
-    c_new = np.empty((ny, nx))
-    flooded = np.empty((ny, nx), np.bool_)
-    for i in range(ny):
-        for j in range(nx):
-            v = c[i, j] + dc[i, j]
-            c_new[i, j] = v
-            flooded[i, j] = (v >= h[i, j] * (1.0 - 1e-9) and not opened[i, j]
-                             and not cavitated[i, j] and not island[i, j])
-    return c_new, flooded
 
 
 @njit(cache=True)
@@ -371,197 +353,3 @@ def band_cholesky_solve(data, indices, indptr, rhs, max_band):
             s -= low[k, band + i - k] * x[k]
         x[i] = s / low[i, band]
     return x, True
-
-
-@njit(cache=True)
-def net_inflow(qx, qy, q_last, q_side, q_supply):
-    """Net inflow of every cell [m3/s] from the face fluxes (lo -> hi: x faces (ny, nx - 1),
-    y faces (ny - 1, nx)), the supply into the first column and the outflow through the last
-    column and the side row."""
-    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
-    net = np.empty((ny, nx))
-    for i in range(ny):
-        for j in range(nx):
-            v = 0.0
-            if j < nx - 1:
-                v -= qx[i, j]
-            if j > 0:
-                v += qx[i, j - 1]
-            if i < ny - 1:
-                v -= qy[i, j]
-            if i > 0:
-                v += qy[i - 1, j]
-            if j == 0:
-                v += q_supply[i]
-            if j == nx - 1:
-                v -= q_last[i]
-            if i == ny - 1:
-                v -= q_side[j]
-            net[i, j] = v
-    return net
-
-
-@njit(cache=True)
-def _given(qx, qy, q_last, q_side, mx, my, outer):
-    """What every cell gives up [m3/s]: its outgoing fluxes on the faces ``mx`` / ``my``
-    mark, and through the outlet and the side when ``outer``."""
-    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
-    out = np.empty((ny, nx))
-    for i in range(ny):
-        for j in range(nx):
-            v = 0.0
-            if j < nx - 1 and mx[i, j]:
-                v += max(qx[i, j], 0.0)
-            if j > 0 and mx[i, j - 1]:
-                v += max(-qx[i, j - 1], 0.0)
-            if i < ny - 1 and my[i, j]:
-                v += max(qy[i, j], 0.0)
-            if i > 0 and my[i - 1, j]:
-                v += max(-qy[i - 1, j], 0.0)
-            if outer and j == nx - 1:
-                v += max(q_last[i], 0.0)
-            if outer and i == ny - 1:
-                v += max(q_side[j], 0.0)
-            out[i, j] = v
-    return out
-
-
-@njit(cache=True)
-def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_x, draw_y,
-              layer, short):
-    """Cut back the fluxes out of open cells (neither ``flooded`` nor ``island``) that would
-    give more than they hold (their oil ``c`` [m] on cells of ``d`` [m] over the step ``dt``
-    [s]; short below ``short`` / dt [m3/s]): first on the faces where the flooded region
-    draws on them (``draw_x`` / ``draw_y``), then, after the films the cells
-    behind a receding meniscus (``layer``) lay are drawn from the cell before them, on every
-    face and through the outlet and the side. Each round scales every short cell's outgoing
-    fluxes by what it can give, at most 100 rounds a pass. Returns the new qx, qy, q_last,
-    q_side and every cell's net inflow with them [m3/s] (:func:`net_inflow`;
-    :meth:`ehlfoam.thinfilm.operators.Operators.move`)."""
-    qx, qy = qx.copy(), qy.copy()
-    q_last, q_side = q_last.copy(), q_side.copy()
-    ny, nx = c.shape
-    held = np.empty((ny, nx))              # [m3/s] over the step
-    short_at = np.empty((ny, nx))
-    opn = np.empty((ny, nx), np.bool_)
-    for i in range(ny):
-        for j in range(nx):
-            held[i, j] = c[i, j] * d * d / dt
-            short_at[i, j] = short[i, j] / dt
-            opn[i, j] = not flooded[i, j] and not island[i, j]
-    all_x = np.ones(qx.shape, np.bool_)
-    all_y = np.ones(qy.shape, np.bool_)
-    net = np.empty((ny, nx))
-    fresh = False
-    for only_draws in (True, False):
-        mx = draw_x if only_draws else all_x
-        my = draw_y if only_draws else all_y
-        if not only_draws:
-            net = net_inflow(qx, qy, q_last, q_side, q_supply)
-            for i in range(ny):
-                for j in range(1, nx):
-                    if layer[i, j] and opn[i, j]:
-                        qx[i, j - 1] += max(-(held[i, j] + net[i, j]), 0.0)
-        fresh = False                       # net is that of the fluxes now
-        for _ in range(100):
-            net = net_inflow(qx, qy, q_last, q_side, q_supply)
-            short, any_short = _short(opn, held, net, short_at)
-            if not any_short:
-                fresh = True
-                break
-            give = _given(qx, qy, q_last, q_side, mx, my, not only_draws)
-            short = short & (give > 0)
-            if not short.any():
-                fresh = True
-                break
-            scale = np.ones((ny, nx))
-            for i in range(ny):
-                for j in range(nx):
-                    if short[i, j]:
-                        room = (held[i, j] + net[i, j] + give[i, j]) / give[i, j]
-                        scale[i, j] = min(max(room, 0.0), 1.0 - 1e-12)
-            for i in range(ny):
-                for j in range(nx - 1):
-                    if mx[i, j]:
-                        qx[i, j] *= scale[i, j] if qx[i, j] > 0 else scale[i, j + 1]
-            for i in range(ny - 1):
-                for j in range(nx):
-                    if my[i, j]:
-                        qy[i, j] *= scale[i, j] if qy[i, j] > 0 else scale[i + 1, j]
-            if not only_draws:
-                for i in range(ny):
-                    q_last[i] *= scale[i, nx - 1]
-                for j in range(nx):
-                    q_side[j] *= scale[ny - 1, j]
-    if not fresh:
-        net = net_inflow(qx, qy, q_last, q_side, q_supply)
-    return qx, qy, q_last, q_side, net
-
-
-@njit(cache=True)
-def _short(opn, held, net, short_at):
-    """The open cells whose oil ``held`` plus ``net`` inflow falls below ``short_at`` (all
-    [m3/s] over the step), and whether there is one."""
-    ny, nx = opn.shape
-    short = np.zeros((ny, nx), np.bool_)
-    found = False
-    for i in range(ny):
-        for j in range(nx):
-            if opn[i, j] and held[i, j] + net[i, j] < short_at[i, j]:
-                short[i, j] = True
-                found = True
-    return short, found
-
-
-@njit(cache=True)
-def _poiseuille(f_lo, f_hi, p_lo, p_hi, g, g_m, p_m):
-    """Poiseuille flux lo -> hi [m3/s] across one face: between two flooded cells, or from a
-    flooded cell to the meniscus in its open neighbour; none between open cells."""
-    if f_lo and f_hi:
-        return g * (p_lo - p_hi)
-    if f_lo:
-        return g_m * (p_lo - p_m)
-    if f_hi:
-        return g_m * (p_m - p_hi)
-    return 0.0
-
-
-@njit(cache=True)
-def face_fluxes(flooded, p, c, cavity, island, cap, film, hx_m, gx, gy, cx, mgx, mpx, mgy,
-                mpy, u, d):
-    """The faces' fluxes lo -> hi before any open cell is held to what it holds [m3/s]
-    (:meth:`ehlfoam.thinfilm.operators.Operators.move`): on x faces Poiseuille where a side
-    is flooded plus what the walls carry (a full gap, Couette, out of a flooded cell; the
-    films f h a receding meniscus lays out of the cell behind one, h its gap there
-    ``hx_m``; at most the films ``cap`` out of an open cell beside the region; else the
-    cell's oil, all of a cavity's), on y faces Poiseuille alone; the faces on which an open
-    cell gives to a flooded one; and the cells behind a receding meniscus."""
-    ny, nx = flooded.shape
-    qx = np.empty((ny, nx - 1))
-    qy = np.empty((ny - 1, nx))
-    draw_x = np.zeros((ny, nx - 1), np.bool_)
-    draw_y = np.zeros((ny - 1, nx), np.bool_)
-    layer = np.zeros((ny, nx), np.bool_)
-    for i in range(ny):
-        for j in range(nx - 1):
-            fl, fr = flooded[i, j], flooded[i, j + 1]
-            touch = False
-            if not fl and not island[i, j] and not cavity[i, j]:
-                touch = ((i > 0 and flooded[i - 1, j]) or (i + 1 < ny and flooded[i + 1, j])
-                         or (j > 0 and flooded[i, j - 1]) or fr)
-            carry = min(c[i, j], cap[i, j]) if touch and not fr else c[i, j]
-            if (j > 0 and flooded[i, j - 1] and not fl and not fr
-                    and not cavity[i, j]):      # behind a receding meniscus: its films
-                carry = film * hx_m[i, j - 1]
-                layer[i, j] = True
-            q = _poiseuille(fl, fr, p[i, j], p[i, j + 1], gx[i, j], mgx[i, j], mpx[i, j])
-            q += cx[i, j] if fl else u * carry * d * (1.0 if gx[i, j] > 0 else 0.0)
-            qx[i, j] = q
-            draw_x[i, j] = (not fl and fr and q > 0) or (fl and not fr and q < 0)
-    for i in range(ny - 1):
-        for j in range(nx):
-            lo, hi = flooded[i, j], flooded[i + 1, j]
-            q = _poiseuille(lo, hi, p[i, j], p[i + 1, j], gy[i, j], mgy[i, j], mpy[i, j])
-            qy[i, j] = q
-            draw_y[i, j] = (not lo and hi and q > 0) or (lo and not hi and q < 0)
-    return qx, qy, draw_x, draw_y, layer

@@ -73,7 +73,7 @@ from dataclasses import replace
 import numpy as np
 
 from ehlfoam.thinfilm.gas import CavityGas
-from ehlfoam.thinfilm.kernels import advance_oil
+from ehlfoam.thinfilm.flux_kernels import advance_oil
 from ehlfoam.thinfilm.operators import Operators, Step
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 from ehlfoam.thinfilm.solution import (ThinFilmSolution, connected_region, gas_on,

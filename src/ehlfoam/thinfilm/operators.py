@@ -14,9 +14,9 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
 from ehlfoam.thinfilm.cavity import cavities_and_outer_air
-from ehlfoam.thinfilm.kernels import (band_cholesky_solve, face_fluxes, fill, hold_back,
-                                      meniscus_faces, pressure_on_grid,
-                                      pressure_system)
+from ehlfoam.thinfilm.flux_kernels import face_fluxes, hold_back
+from ehlfoam.thinfilm.kernels import (band_cholesky_solve, fill, meniscus_faces,
+                                      pressure_on_grid, pressure_system)
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
