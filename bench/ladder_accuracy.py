@@ -19,9 +19,10 @@ width, bubble or wake length, oil held) each rung's error against it: the state 
 wrong, the others relative, each metric the run's mean over its last transit (a single
 write carries the menisci's jitter; the last write's where the state changed within it).
 Cost: the CPU time of the run (the process's own, the thin-film start included, plus the
-OpenFOAM solver's on every rank), the EHL precalc excluded (solved first, cached). Prints a row per point and rung and a summary per rung (error, median CPU, CPU
-against the reference's); ``--charts DIR`` draws one chart per metric, error against CPU
-(log axis), a marker per rung. ``--quick``: two points on the two cheapest thin-film levels
+OpenFOAM solver's on every rank), the EHL precalc excluded (solved first, cached). Prints a
+row per point and rung and a summary per rung (error, median CPU, CPU against the
+reference's); ``--charts DIR`` draws one chart per metric, error against CPU (log axis), a
+marker per rung. ``--quick``: two points on the two cheapest thin-film levels
 over a small domain (seconds).
 """
 

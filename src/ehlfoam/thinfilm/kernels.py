@@ -64,10 +64,10 @@ def _numbering(flooded, by_column, bounds):
 def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_supply,
                     g_side, g_out, cx_out):
     """The flooded cells' pressure system: CSR ``(data, indices, indptr)`` with sorted
-    columns, the right-hand side [m3/s], and whether the cells are numbered column by
-    column (y fastest) rather than row by row, whichever gives the narrower band (a region
-    longer than it is wide: by column). Faces with a positive conductance (``gx``: x faces
-    (ny, nx - 1), ``gy``: y faces (ny - 1, nx) [m3/(Pa s)]) join two flooded cells, or a
+    columns, the right-hand side [m3/s], and every cell's number in it (-1 off the flooded
+    cells), column by column (y fastest) or row by row, whichever gives the narrower band
+    (a region longer than it is wide: by column). Faces with a positive conductance (``gx``:
+    x faces (ny, nx - 1), ``gy``: y faces (ny - 1, nx) [m3/(Pa s)]) join two flooded cells, or a
     flooded cell to the meniscus in its open neighbour (conductance ``mgx`` / ``mgy``,
     pressure ``mpx`` / ``mpy`` [Pa]); ``cx``: the Couette flux of a full x face [m3/s];
     the supply into the first column, the side row's and the last column's outflow
@@ -158,23 +158,19 @@ def pressure_system(flooded, c, h, d, dt, u, gx, gy, cx, mgx, mgy, mpx, mpy, q_s
                 data[k], indices[k] = row_vals[t], row_cols[t]
                 k += 1
             indptr[r + 1] = k
-    return data[:k], indices[:k], indptr, rhs, by_column
+    return data[:k], indices[:k], indptr, rhs, idx
 
 
 @njit(cache=True)
-def pressure_on_grid(flooded, x, by_column):
-    """The flooded cells' pressures ``x`` (numbered as :func:`pressure_system` numbers them:
-    column by column where ``by_column``, else row by row) on the grid, NaN elsewhere."""
-    ny, nx = flooded.shape
-    i0, i1, j0, j1 = _bounds(flooded)
+def pressure_on_grid(idx, x):
+    """The flooded cells' pressures ``x`` on the grid, each at its number ``idx`` (as
+    :func:`pressure_system` numbers them; -1 elsewhere), NaN elsewhere."""
+    ny, nx = idx.shape
     p = np.full((ny, nx), np.nan)
-    n = 0
-    for outer in range(j0, j1 + 1) if by_column else range(i0, i1 + 1):
-        for inner in range(i0, i1 + 1) if by_column else range(j0, j1 + 1):
-            i, j = (inner, outer) if by_column else (outer, inner)
-            if flooded[i, j]:
-                p[i, j] = x[n]
-                n += 1
+    for i in range(ny):
+        for j in range(nx):
+            if idx[i, j] >= 0:
+                p[i, j] = x[idx[i, j]]
     return p
 
 

@@ -72,8 +72,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ehlfoam.thinfilm.gas import CavityGas
 from ehlfoam.thinfilm.flux_kernels import advance_oil
+from ehlfoam.thinfilm.gas import CavityGas
 from ehlfoam.thinfilm.operators import Operators, Step
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 from ehlfoam.thinfilm.solution import (ThinFilmSolution, connected_region, gas_on,
@@ -229,8 +229,7 @@ class Marcher:
         self.c, self.flooded = advance_oil(self.c, s.dc, self.h, s.opened, s.cavitated,
                                            self.grid.island)
         if gas is not None:
-            new = self.cavity()
-            outer = ~self.flooded & ~self.grid.island & ~new
+            new, outer = self.ops.open_cells(self.flooded)   # a gas balance: a p_cav too
             gas.advance(s.cavity, c_old, new, outer, self.c,
                         flooded_old & ~s.opened & ~s.cavitated, dt)
         self.p = s.p

@@ -101,12 +101,12 @@ class Operators:
         """The open cells whose gas the flooded region encloses, at the cavitation pressure
         (:func:`ehlfoam.thinfilm.cavity.cavities`; ``before``: the outer air of a flooded
         set that held this one); none without one."""
-        return self._open_cells(flooded, before)[0]
+        return self.open_cells(flooded, before)[0]
 
-    def _open_cells(self, flooded: np.ndarray,
-                    before: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    def open_cells(self, flooded: np.ndarray,
+                   before: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray | None]:
         """:meth:`cavities` and the outer air they were told from (None without a
-        cavitation pressure)."""
+        cavitation pressure): the open cells, not island, are the two together."""
         if self.p_cav is None:
             return np.zeros_like(flooded), None
         return cavities_and_outer_air(flooded, self.island, self.closed_side, before)
@@ -146,10 +146,10 @@ class Operators:
         outflow is what it holds beyond its gap / dt."""
         if not flooded.any():
             return np.full(flooded.shape, np.nan)
-        data, indices, indptr, rhs, by_column = pressure_system(
+        data, indices, indptr, rhs, idx = pressure_system(
             flooded, c, self.h, self.d, dt, self.u, self.gx, self.gy, self.cx, faces.gx,
             faces.gy, faces.px, faces.py, self.q_supply, self.g_side, self.g_out, self.cx_out)
-        return pressure_on_grid(flooded, _solve(data, indices, indptr, rhs), by_column)
+        return pressure_on_grid(idx, _solve(data, indices, indptr, rhs))
 
     def step(self, flooded: np.ndarray, c: np.ndarray, dt: float,
              gas: Callable[[np.ndarray], np.ndarray] | None = None) -> "Step":
@@ -165,7 +165,7 @@ class Operators:
         cavitated = np.zeros_like(flooded)
         outer = None        # the outer air of the last pass: each pass only opens cells
         for _ in range(1000):
-            cavity, outer = self._open_cells(flooded, outer)
+            cavity, outer = self.open_cells(flooded, outer)
             faces = self.menisci(flooded, c, cavity,
                                  None if gas is None or not cavity.any() else gas(cavity))
             p = self.pressure(flooded, c, dt, faces)
