@@ -31,6 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from ehlfoam.thinfilm.kernels import edge_connected, edge_connected_from
+from ehlfoam.thinfilm.pass_kernels import open_cells
 
 __all__ = ["cavities", "cavities_and_outer_air", "outer_air"]
 
@@ -60,6 +61,9 @@ def cavities_and_outer_air(flooded: np.ndarray, island: np.ndarray, closed_side:
                            before: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """:func:`cavities` and the outer air they were told from (:func:`outer_air`): the
     open cells are the two together."""
-    gas = ~flooded & ~island
-    outer = outer_air(gas, closed_side, before)
-    return gas & ~outer, outer
+    flooded = np.ascontiguousarray(flooded, dtype=np.bool_)
+    island = np.ascontiguousarray(island, dtype=np.bool_)
+    if before is None:
+        return open_cells(flooded, island, closed_side, flooded, False)
+    return open_cells(flooded, island, closed_side,
+                      np.ascontiguousarray(before, dtype=np.bool_), True)

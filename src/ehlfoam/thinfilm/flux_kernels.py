@@ -21,45 +21,52 @@ def net_inflow(qx, qy, q_last, q_side, q_supply):
     net = np.empty((ny, nx))
     for i in range(ny):
         for j in range(nx):
-            v = 0.0
-            if j < nx - 1:
-                v -= qx[i, j]
-            if j > 0:
-                v += qx[i, j - 1]
-            if i < ny - 1:
-                v -= qy[i, j]
-            if i > 0:
-                v += qy[i - 1, j]
-            if j == 0:
-                v += q_supply[i]
-            if j == nx - 1:
-                v -= q_last[i]
-            if i == ny - 1:
-                v -= q_side[j]
-            net[i, j] = v
+            net[i, j] = _net_at(qx, qy, q_last, q_side, q_supply, i, j)
     return net
 
 
+@njit(cache=True, inline="always")
+def _net_at(qx, qy, q_last, q_side, q_supply, i, j):
+    """:func:`net_inflow` of the cell ``(i, j)``: the same additions in the same order."""
+    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
+    v = 0.0
+    if j < nx - 1:
+        v -= qx[i, j]
+    if j > 0:
+        v += qx[i, j - 1]
+    if i < ny - 1:
+        v -= qy[i, j]
+    if i > 0:
+        v += qy[i - 1, j]
+    if j == 0:
+        v += q_supply[i]
+    if j == nx - 1:
+        v -= q_last[i]
+    if i == ny - 1:
+        v -= q_side[j]
+    return v
+
+
 @njit(cache=True)
-def _given(qx, qy, q_last, q_side, mx, my, outer):
+def _given(qx, qy, q_last, q_side, mx, my, every):
     """What every cell gives up [m3/s]: its outgoing fluxes on the faces ``mx`` / ``my``
-    mark, and through the outlet and the side when ``outer``."""
+    mark, or, when ``every``, on all faces and through the outlet and the side."""
     ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
     out = np.empty((ny, nx))
     for i in range(ny):
         for j in range(nx):
             v = 0.0
-            if j < nx - 1 and mx[i, j]:
+            if j < nx - 1 and (every or mx[i, j]):
                 v += max(qx[i, j], 0.0)
-            if j > 0 and mx[i, j - 1]:
+            if j > 0 and (every or mx[i, j - 1]):
                 v += max(-qx[i, j - 1], 0.0)
-            if i < ny - 1 and my[i, j]:
+            if i < ny - 1 and (every or my[i, j]):
                 v += max(qy[i, j], 0.0)
-            if i > 0 and my[i - 1, j]:
+            if i > 0 and (every or my[i - 1, j]):
                 v += max(-qy[i - 1, j], 0.0)
-            if outer and j == nx - 1:
+            if every and j == nx - 1:
                 v += max(q_last[i], 0.0)
-            if outer and i == ny - 1:
+            if every and i == ny - 1:
                 v += max(q_side[j], 0.0)
             out[i, j] = v
     return out
@@ -76,7 +83,12 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
     face and through the outlet and the side. Each round scales every short cell's outgoing
     fluxes by what it can give, at most 100 rounds a pass. Returns the new qx, qy, q_last,
     q_side and every cell's net inflow with them [m3/s] (:func:`net_inflow`;
-    :meth:`ehlfoam.thinfilm.operators.Operators.move`)."""
+    :func:`ehlfoam.thinfilm.pass_kernels.moves`).
+
+    The net inflow is read anew only where the fluxes changed: in full after a round that
+    scaled some, on the cells beside the films' faces after those were drawn (the same
+    additions per cell, so bitwise what a full reading gives); a reading that finds no short
+    cell ends the round."""
     qx, qy = qx.copy(), qy.copy()
     q_last, q_side = q_last.copy(), q_side.copy()
     ny, nx = c.shape
@@ -88,30 +100,24 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
             held[i, j] = c[i, j] * d * d / dt
             short_at[i, j] = short[i, j] / dt
             opn[i, j] = not flooded[i, j] and not island[i, j]
-    all_x = np.ones(qx.shape, np.bool_)
-    all_y = np.ones(qy.shape, np.bool_)
-    net = np.empty((ny, nx))
-    fresh = False
+    net = net_inflow(qx, qy, q_last, q_side, q_supply)
+    fresh = True                            # net is that of the fluxes now
     for only_draws in (True, False):
-        mx = draw_x if only_draws else all_x
-        my = draw_y if only_draws else all_y
         if not only_draws:
-            net = net_inflow(qx, qy, q_last, q_side, q_supply)
-            for i in range(ny):
-                for j in range(1, nx):
-                    if layer[i, j] and opn[i, j]:
-                        qx[i, j - 1] += max(-(held[i, j] + net[i, j]), 0.0)
-        fresh = False                       # net is that of the fluxes now
+            if not fresh:
+                net = net_inflow(qx, qy, q_last, q_side, q_supply)
+            _draw_films(qx, qy, q_last, q_side, q_supply, held, net, layer, opn)
+            fresh = True
         for _ in range(100):
-            net = net_inflow(qx, qy, q_last, q_side, q_supply)
+            if not fresh:
+                net = net_inflow(qx, qy, q_last, q_side, q_supply)
+                fresh = True
             short, any_short = _short(opn, held, net, short_at)
             if not any_short:
-                fresh = True
                 break
-            give = _given(qx, qy, q_last, q_side, mx, my, not only_draws)
+            give = _given(qx, qy, q_last, q_side, draw_x, draw_y, not only_draws)
             short = short & (give > 0)
             if not short.any():
-                fresh = True
                 break
             scale = np.ones((ny, nx))
             for i in range(ny):
@@ -121,20 +127,41 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
                         scale[i, j] = min(max(room, 0.0), 1.0 - 1e-12)
             for i in range(ny):
                 for j in range(nx - 1):
-                    if mx[i, j]:
+                    if not only_draws or draw_x[i, j]:
                         qx[i, j] *= scale[i, j] if qx[i, j] > 0 else scale[i, j + 1]
             for i in range(ny - 1):
                 for j in range(nx):
-                    if my[i, j]:
+                    if not only_draws or draw_y[i, j]:
                         qy[i, j] *= scale[i, j] if qy[i, j] > 0 else scale[i + 1, j]
             if not only_draws:
                 for i in range(ny):
                     q_last[i] *= scale[i, nx - 1]
                 for j in range(nx):
                     q_side[j] *= scale[ny - 1, j]
+            fresh = False
     if not fresh:
         net = net_inflow(qx, qy, q_last, q_side, q_supply)
     return qx, qy, q_last, q_side, net
+
+
+@njit(cache=True)
+def _draw_films(qx, qy, q_last, q_side, q_supply, held, net, layer, opn):
+    """The films the open cells behind a receding meniscus (``layer``) lay, drawn from the
+    cell before each where they hold less than they give (``net``: the net inflows before
+    any is drawn, updated after, in place, on the cells whose inflow that changed)."""
+    ny, nx = held.shape
+    touched = np.zeros((ny, nx), np.bool_)
+    for i in range(ny):
+        for j in range(1, nx):
+            if layer[i, j] and opn[i, j]:
+                before = qx[i, j - 1]
+                qx[i, j - 1] += max(-(held[i, j] + net[i, j]), 0.0)
+                if qx[i, j - 1] != before or before == 0.0:   # a zero may change its sign
+                    touched[i, j - 1] = touched[i, j] = True
+    for i in range(ny):
+        for j in range(nx):
+            if touched[i, j]:
+                net[i, j] = _net_at(qx, qy, q_last, q_side, q_supply, i, j)
 
 
 @njit(cache=True)
@@ -169,7 +196,7 @@ def _poiseuille(f_lo, f_hi, p_lo, p_hi, g, g_m, p_m):
 def face_fluxes(flooded, p, c, cavity, island, cap, film, hx_m, gx, gy, cx, mgx, mpx, mgy,
                 mpy, u, d):
     """The faces' fluxes lo -> hi before any open cell is held to what it holds [m3/s]
-    (:meth:`ehlfoam.thinfilm.operators.Operators.move`): on x faces Poiseuille where a side
+    (:func:`ehlfoam.thinfilm.pass_kernels.moves`): on x faces Poiseuille where a side
     is flooded plus what the walls carry (a full gap, Couette, out of a flooded cell; the
     films f h a receding meniscus lays out of the cell behind one, h its gap there
     ``hx_m``; at most the films ``cap`` out of an open cell beside the region; else the

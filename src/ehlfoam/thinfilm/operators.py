@@ -14,9 +14,9 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.linalg import spsolve
 
 from ehlfoam.thinfilm.cavity import cavities_and_outer_air
-from ehlfoam.thinfilm.flux_kernels import face_fluxes, hold_back
-from ehlfoam.thinfilm.kernels import (band_cholesky_solve, fill, meniscus_faces,
-                                      pressure_on_grid, pressure_system)
+from ehlfoam.thinfilm.kernels import fill, pressure_on_grid
+from ehlfoam.thinfilm.pass_kernels import (DONE, NEEDS_LU, PassConstants, after_pressure,
+                                           flooded_pressure, menisci, one_pass)
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
@@ -65,7 +65,17 @@ class Operators:
         ahead = (grid.x < 0)[None, :] & np.ones_like(self.island)
         self.layers = np.where(ahead, np.maximum(incoming[:, None], self.cap), self.cap)
         self._ones = np.ones_like(self.h)              # the static menisci's factor
-        self._short = -1e-12 * self.h * d * d          # a cell short of oil: below it / dt
+        self._none = np.zeros_like(self.island)        # no cells
+        self.k = PassConstants(
+            h=self.h, layers=self.layers, island=self.island, gx=self.gx, gy=self.gy,
+            cx=self.cx, cap=self.cap, film=float(self.film), u=float(u), d=float(d),
+            g_side=np.ascontiguousarray(self.g_side, dtype=float), g_out=self.g_out,
+            cx_out=self.cx_out, q_supply=np.ascontiguousarray(self.q_supply, dtype=float),
+            short=-1e-12 * self.h * d * d,             # a cell short of oil: below it / dt
+            young_laplace=float(self.young_laplace),
+            p_cav=0.0 if self.p_cav is None else float(self.p_cav),
+            has_cav=self.p_cav is not None, closed_side=bool(self.closed_side),
+            sub_cell=bool(self.sub_cell))
 
     def pull_factor(self, flooded: np.ndarray) -> np.ndarray | float:
         """The dynamic menisci's pressure on every cell, a factor on the static one. The
@@ -126,30 +136,16 @@ class Operators:
         like the outer air's, Young-Laplace's below that gas pressure, floored alike."""
         if cavity is None:
             cavity = np.zeros_like(flooded)
-        factor = self.pull_factor(flooded)
-        factor = self._ones if np.isscalar(factor) else np.ascontiguousarray(factor, dtype=float)
-        theta = 0.5 + self.fill(c, cavity) if self.sub_cell else np.ones_like(c)
-        has_gas = gas is not None and self.p_cav is not None
-        gas = np.asarray(gas, dtype=float) if has_gas else self.h
-        p_cav = 0.0 if self.p_cav is None else float(self.p_cav)
-        gx, px, hx = meniscus_faces(flooded, theta, self.h, factor, self.young_laplace,
-                                    self.gx, cavity, gas, p_cav, self.p_cav is not None,
-                                    has_gas, 1)
-        gy, py, _ = meniscus_faces(flooded, theta, self.h, factor, self.young_laplace,
-                                   self.gy, cavity, gas, p_cav, self.p_cav is not None,
-                                   has_gas, 0)
-        return _Faces(gx=gx, gy=gy, px=px, py=py, hx=hx)
+        return _Faces(*menisci(flooded, c, cavity, self._factor(flooded),
+                               *self._gas(gas), self.k))
 
     def pressure(self, flooded: np.ndarray, c: np.ndarray, dt: float,
                  faces: "_Faces") -> np.ndarray:
         """p on the flooded cells, the menisci at ``faces``' pressures: each flooded cell's
         outflow is what it holds beyond its gap / dt."""
-        if not flooded.any():
-            return np.full(flooded.shape, np.nan)
-        data, indices, indptr, rhs, idx = pressure_system(
-            flooded, c, self.h, self.d, dt, self.u, self.gx, self.gy, self.cx, faces.gx,
-            faces.gy, faces.px, faces.py, self.q_supply, self.g_side, self.g_out, self.cx_out)
-        return pressure_on_grid(idx, _solve(data, indices, indptr, rhs))
+        p, ok, *system = flooded_pressure(flooded, c, dt, faces.gx, faces.gy, faces.px,
+                                          faces.py, self.k, MAX_BAND)
+        return p if ok else _by_lu(*system)
 
     def step(self, flooded: np.ndarray, c: np.ndarray, dt: float,
              gas: Callable[[np.ndarray], np.ndarray] | None = None) -> "Step":
@@ -160,57 +156,49 @@ class Operators:
         Elrod-Adams's complementarity, :mod:`ehlfoam.thinfilm.cavity`); p is solved again
         until neither happens. ``gas``: the cavities' gas pressures (gauge [Pa] on their
         cells) for a set of cavity cells, where a gas balance sets them
-        (:mod:`ehlfoam.thinfilm.gas`); None: at the cavitation pressure."""
+        (:mod:`ehlfoam.thinfilm.gas`); None: at the cavitation pressure.
+
+        Each pass is one kernel (:func:`~ehlfoam.thinfilm.pass_kernels.one_pass`); the
+        oil's moves in it: the change of every cell's oil and the fluxes through the outlet
+        and the side. An open cell gives no more than it holds: what the flooded region
+        draws from it is cut back first (the flooded cell runs short of a full gap), the
+        films and layers it passes on only when that is not enough; a cavity's cells pass
+        on all the oil they hold, as no air meniscus holds it back."""
         opened = np.zeros_like(flooded)
         cavitated = np.zeros_like(flooded)
         outer = None        # the outer air of the last pass: each pass only opens cells
         for _ in range(1000):
-            cavity, outer = self.open_cells(flooded, outer)
-            faces = self.menisci(flooded, c, cavity,
-                                 None if gas is None or not cavity.any() else gas(cavity))
-            p = self.pressure(flooded, c, dt, faces)
-            if self.p_cav is not None:
-                low = flooded & (p < self.p_cav - 1e-9 * abs(self.p_cav))
-                if low.any():
-                    cavitated |= low
-                    flooded = flooded & ~low
-                    continue
-            dc, q_outlet, q_side, rows = self.move(flooded, p, c, dt, faces, cavity,
-                                                   by_row=True)
-            dry = flooded & (c + dc < 0.0)
-            if not dry.any():
-                return Step(p, dc, q_outlet, q_side, opened, cavitated, cavity, rows)
-            opened |= dry
-            flooded = flooded & ~dry
+            if gas is None:
+                cavity, pressures = self._none, None
+            else:       # the gas balance's pressures are those of the cavities found
+                cavity, outer = self.open_cells(flooded, outer)
+                pressures = gas(cavity) if cavity.any() else None
+            status, flooded, cavity, found, p, dc, q_last, q_side, faces, system = one_pass(
+                flooded, c, dt, cavity, self._none if outer is None else outer, gas is None,
+                outer is not None, self._factor(flooded), *self._gas(pressures), opened,
+                cavitated, self.k, MAX_BAND)
+            if gas is None and self.p_cav is not None:
+                outer = found
+            if status == NEEDS_LU:
+                p = _by_lu(*system)
+                status, flooded, dc, q_last, q_side = after_pressure(
+                    flooded, p, c, dt, cavity, *faces, opened, cavitated, self.k)
+            if status == DONE:
+                return Step(p, dc, float(q_last.sum()), float(q_side.sum()), opened,
+                            cavitated, cavity, q_last)
         raise RuntimeError("the flooded set did not settle within a step")
 
-    def move(self, flooded: np.ndarray, p: np.ndarray, c: np.ndarray, dt: float,
-             faces: "_Faces", cavity: np.ndarray | None = None, by_row: bool = False):
-        """The change of the oil in every cell over dt [m] and the fluxes leaving the
-        domain through the outlet and the side [m3/s], the menisci at ``faces``. An open
-        cell gives no more than it holds: what the flooded region draws from it is cut back
-        first (the flooded cell runs short of a full gap), the films and layers it passes on
-        only when that is not enough. A cavity's cells (``cavity``) pass on all the oil they
-        hold, as no air meniscus holds it back. ``by_row``: the outlet's flux on each row
-        [m3/s] too, a fourth item."""
-        u, d = self.u, self.d
-        if cavity is None:
-            cavity = np.zeros_like(flooded)
-        # x faces lo -> hi: Poiseuille where a side is flooded, plus what the walls carry:
-        # a full gap out of a flooded cell, the films a receding meniscus lays out of the
-        # cell behind one, at most those films out of a cell beside one, else the layers;
-        # all of a cavity's oil; and the faces on which an open cell gives to a flooded one
-        qx, qy, draw_x, draw_y, layer = face_fluxes(
-            flooded, p, c, cavity, self.island, self.cap, float(self.film), faces.hx,
-            self.gx, self.gy, self.cx, faces.gx, faces.px, faces.gy, faces.py, u, d)
-        q_side = np.where(flooded[-1], self.g_side * p[-1], 0.0)
-        q_last = np.where(flooded[:, -1], self.cx_out + self.g_out * p[:, -1],
-                          u * c[:, -1] * d)
-        qx, qy, q_last, q_side, net = hold_back(
-            qx, qy, np.asarray(q_last, dtype=float), np.asarray(q_side, dtype=float),
-            self.q_supply, c, d, dt, flooded, self.island, draw_x, draw_y, layer, self._short)
-        out = net * dt / (d * d), float(q_last.sum()), float(q_side.sum())
-        return (*out, q_last) if by_row else out
+    def _factor(self, flooded: np.ndarray) -> np.ndarray:
+        """The dynamic menisci's factor on every cell (:meth:`pull_factor`), as an array."""
+        factor = self.pull_factor(flooded)
+        return self._ones if np.isscalar(factor) else np.ascontiguousarray(factor, dtype=float)
+
+    def _gas(self, gas: np.ndarray | None) -> tuple[np.ndarray, bool]:
+        """The cavities' gas pressures as the menisci read them, and whether there are any
+        (there are not without a cavitation pressure)."""
+        if gas is None or self.p_cav is None:
+            return self.h, False
+        return np.ascontiguousarray(gas, dtype=float), True
 
 
 class Step(NamedTuple):
@@ -249,17 +237,16 @@ class _Faces(NamedTuple):
 MAX_BAND = 48
 
 
-def _solve(data: np.ndarray, indices: np.ndarray, indptr: np.ndarray,
-           rhs: np.ndarray) -> np.ndarray:
-    """The flooded cells' pressure from their symmetric positive definite system (CSR): a
-    banded Cholesky factorisation where the band (the region's narrower side, in cells) is
-    up to ``MAX_BAND`` wide, sparse LU where it is wider or a pivot not positive."""
-    x, ok = band_cholesky_solve(data, indices, indptr, rhs, MAX_BAND)
-    if ok:
-        return x
+def _by_lu(data: np.ndarray, indices: np.ndarray, indptr: np.ndarray, rhs: np.ndarray,
+           idx: np.ndarray) -> np.ndarray:
+    """p on the grid (NaN off the flooded cells) from the flooded cells' system (CSR, the
+    right-hand side and the cells' numbers) by sparse LU: where the banded Cholesky solve
+    refuses it, as its band (the region's narrower side, in cells) is wider than
+    ``MAX_BAND`` or a pivot is not positive."""
     n = rhs.size
-    return spsolve(csr_matrix((data, indices, indptr), shape=(n, n)), rhs,
-                   permc_spec="MMD_AT_PLUS_A")
+    x = spsolve(csr_matrix((data, indices, indptr), shape=(n, n)), rhs,
+                permc_spec="MMD_AT_PLUS_A")
+    return pressure_on_grid(idx, np.atleast_1d(x))
 
 
 def touches(flooded: np.ndarray) -> np.ndarray:
