@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ehlfoam.thinfilm.kernels import _bounds
+
 
 @njit(cache=True)
 def net_inflow(qx, qy, q_last, q_side, q_supply):
@@ -18,33 +20,46 @@ def net_inflow(qx, qy, q_last, q_side, q_supply):
     y faces (ny - 1, nx)), the supply into the first column and the outflow through the last
     column and the side row."""
     ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
-    net = np.empty((ny, nx))
-    for i in range(ny):
-        for j in range(nx):
-            net[i, j] = _net_at(qx, qy, q_last, q_side, q_supply, i, j)
+    net, zero = np.empty((ny, nx)), np.zeros((ny, nx))
+    no_cells = np.zeros((ny, nx), np.bool_)
+    _read(qx, qy, q_last, q_side, q_supply, net, zero, zero, no_cells, no_cells.copy(),
+          no_cells, True)
     return net
 
 
-@njit(cache=True, inline="always")
-def _net_at(qx, qy, q_last, q_side, q_supply, i, j):
-    """:func:`net_inflow` of the cell ``(i, j)``: the same additions in the same order."""
-    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
-    v = 0.0
-    if j < nx - 1:
-        v -= qx[i, j]
-    if j > 0:
-        v += qx[i, j - 1]
-    if i < ny - 1:
-        v -= qy[i, j]
-    if i > 0:
-        v += qy[i - 1, j]
-    if j == 0:
-        v += q_supply[i]
-    if j == nx - 1:
-        v -= q_last[i]
-    if i == ny - 1:
-        v -= q_side[j]
-    return v
+@njit(cache=True)
+def _read(qx, qy, q_last, q_side, q_supply, net, held, short_at, opn, cut, cells, every):
+    """Every cell's net inflow [m3/s] into ``net`` (only those of ``cells`` unless
+    ``every``), in place, and whether it leaves an open cell (``opn``) short (its oil
+    ``held`` plus its net inflow below ``short_at``, all [m3/s] over the step) into
+    ``cut``; returns how many cells are short then, all over the grid."""
+    ny, nx = net.shape
+    for i in range(ny):
+        for j in range(nx):
+            if not every and not cells[i, j]:
+                continue
+            v = 0.0
+            if j < nx - 1:
+                v -= qx[i, j]
+            if j > 0:
+                v += qx[i, j - 1]
+            if i < ny - 1:
+                v -= qy[i, j]
+            if i > 0:
+                v += qy[i - 1, j]
+            if j == 0:
+                v += q_supply[i]
+            if j == nx - 1:
+                v -= q_last[i]
+            if i == ny - 1:
+                v -= q_side[j]
+            net[i, j] = v
+            cut[i, j] = opn[i, j] and held[i, j] + v < short_at[i, j]
+    n = 0
+    for i in range(ny):
+        for j in range(nx):
+            n += cut[i, j]
+    return n
 
 
 @njit(cache=True)
@@ -85,10 +100,10 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
     q_side and every cell's net inflow with them [m3/s] (:func:`net_inflow`;
     :func:`ehlfoam.thinfilm.pass_kernels.moves`).
 
-    The net inflow is read anew only where the fluxes changed: in full after a round that
-    scaled some, on the cells beside the films' faces after those were drawn (the same
-    additions per cell, so bitwise what a full reading gives); a reading that finds no short
-    cell ends the round."""
+    The net inflow and which cells are short are read over the grid at the start and after
+    each round that scaled fluxes, and on the cells beside the films' faces after those are
+    drawn: bitwise what reading them anew before every round gives, at a fraction of the
+    sweeps (most steps scale nothing)."""
     qx, qy = qx.copy(), qy.copy()
     q_last, q_side = q_last.copy(), q_side.copy()
     ny, nx = c.shape
@@ -100,56 +115,11 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
             held[i, j] = c[i, j] * d * d / dt
             short_at[i, j] = short[i, j] / dt
             opn[i, j] = not flooded[i, j] and not island[i, j]
-    net = net_inflow(qx, qy, q_last, q_side, q_supply)
-    fresh = True                            # net is that of the fluxes now
-    for only_draws in (True, False):
-        if not only_draws:
-            if not fresh:
-                net = net_inflow(qx, qy, q_last, q_side, q_supply)
-            _draw_films(qx, qy, q_last, q_side, q_supply, held, net, layer, opn)
-            fresh = True
-        for _ in range(100):
-            if not fresh:
-                net = net_inflow(qx, qy, q_last, q_side, q_supply)
-                fresh = True
-            short, any_short = _short(opn, held, net, short_at)
-            if not any_short:
-                break
-            give = _given(qx, qy, q_last, q_side, draw_x, draw_y, not only_draws)
-            short = short & (give > 0)
-            if not short.any():
-                break
-            scale = np.ones((ny, nx))
-            for i in range(ny):
-                for j in range(nx):
-                    if short[i, j]:
-                        room = (held[i, j] + net[i, j] + give[i, j]) / give[i, j]
-                        scale[i, j] = min(max(room, 0.0), 1.0 - 1e-12)
-            for i in range(ny):
-                for j in range(nx - 1):
-                    if not only_draws or draw_x[i, j]:
-                        qx[i, j] *= scale[i, j] if qx[i, j] > 0 else scale[i, j + 1]
-            for i in range(ny - 1):
-                for j in range(nx):
-                    if not only_draws or draw_y[i, j]:
-                        qy[i, j] *= scale[i, j] if qy[i, j] > 0 else scale[i + 1, j]
-            if not only_draws:
-                for i in range(ny):
-                    q_last[i] *= scale[i, nx - 1]
-                for j in range(nx):
-                    q_side[j] *= scale[ny - 1, j]
-            fresh = False
-    if not fresh:
-        net = net_inflow(qx, qy, q_last, q_side, q_supply)
-    return qx, qy, q_last, q_side, net
-
-
-@njit(cache=True)
-def _draw_films(qx, qy, q_last, q_side, q_supply, held, net, layer, opn):
-    """The films the open cells behind a receding meniscus (``layer``) lay, drawn from the
-    cell before each where they hold less than they give (``net``: the net inflows before
-    any is drawn, updated after, in place, on the cells whose inflow that changed)."""
-    ny, nx = held.shape
+    net = np.empty((ny, nx))
+    cut = np.zeros((ny, nx), np.bool_)     # the open cells short of oil
+    state = (q_supply, net, held, short_at, opn, cut)
+    n_short = _read(qx, qy, q_last, q_side, *state, cut, True)
+    n_short = _rounds(qx, qy, q_last, q_side, state, n_short, draw_x, draw_y, False)
     touched = np.zeros((ny, nx), np.bool_)
     for i in range(ny):
         for j in range(1, nx):
@@ -158,25 +128,51 @@ def _draw_films(qx, qy, q_last, q_side, q_supply, held, net, layer, opn):
                 qx[i, j - 1] += max(-(held[i, j] + net[i, j]), 0.0)
                 if qx[i, j - 1] != before or before == 0.0:   # a zero may change its sign
                     touched[i, j - 1] = touched[i, j] = True
-    for i in range(ny):
-        for j in range(nx):
-            if touched[i, j]:
-                net[i, j] = _net_at(qx, qy, q_last, q_side, q_supply, i, j)
+    n_short = _read(qx, qy, q_last, q_side, *state, touched, False)
+    _rounds(qx, qy, q_last, q_side, state, n_short, draw_x, draw_y, True)
+    return qx, qy, q_last, q_side, net
 
 
 @njit(cache=True)
-def _short(opn, held, net, short_at):
-    """The open cells whose oil ``held`` plus ``net`` inflow falls below ``short_at`` (all
-    [m3/s] over the step), and whether there is one."""
-    ny, nx = opn.shape
-    short = np.zeros((ny, nx), np.bool_)
-    found = False
-    for i in range(ny):
-        for j in range(nx):
-            if opn[i, j] and held[i, j] + net[i, j] < short_at[i, j]:
-                short[i, j] = True
-                found = True
-    return short, found
+def _rounds(qx, qy, q_last, q_side, state, n_short, draw_x, draw_y, every):
+    """The hold-back's rounds (:func:`hold_back`), in place, on the faces ``draw_x`` /
+    ``draw_y`` or, when ``every``, on every face and through the outlet and the side: each
+    scales the short cells' outgoing fluxes by what they can give, and the net inflows and
+    the short cells are read again; until none is short, none that is can give, or 100
+    rounds. ``state``: the supply, the net inflows, the oil held, the short thresholds, the
+    open cells and the short ones. Returns how many cells are short at the end."""
+    q_supply, net, held, short_at, opn, cut = state
+    ny, nx = net.shape
+    for _ in range(100):
+        if n_short == 0:
+            break
+        give = _given(qx, qy, q_last, q_side, draw_x, draw_y, every)
+        scale = np.ones((ny, nx))
+        scaled = False
+        for i in range(ny):
+            for j in range(nx):
+                if cut[i, j] and give[i, j] > 0:
+                    room = (held[i, j] + net[i, j] + give[i, j]) / give[i, j]
+                    scale[i, j] = min(max(room, 0.0), 1.0 - 1e-12)
+                    scaled = True
+        if not scaled:
+            break
+        for i in range(ny):
+            for j in range(nx - 1):
+                if every or draw_x[i, j]:
+                    qx[i, j] *= scale[i, j] if qx[i, j] > 0 else scale[i, j + 1]
+        for i in range(ny - 1):
+            for j in range(nx):
+                if every or draw_y[i, j]:
+                    qy[i, j] *= scale[i, j] if qy[i, j] > 0 else scale[i + 1, j]
+        if every:
+            for i in range(ny):
+                q_last[i] *= scale[i, nx - 1]
+            for j in range(nx):
+                q_side[j] *= scale[ny - 1, j]
+        n_short = _read(qx, qy, q_last, q_side, q_supply, net, held, short_at, opn, cut,
+                        cut, True)
+    return n_short
 
 
 @njit(cache=True)
@@ -201,15 +197,24 @@ def face_fluxes(flooded, p, c, cavity, island, cap, film, hx_m, gx, gy, cx, mgx,
     films f h a receding meniscus lays out of the cell behind one, h its gap there
     ``hx_m``; at most the films ``cap`` out of an open cell beside the region; else the
     cell's oil, all of a cavity's), on y faces Poiseuille alone; the faces on which an open
-    cell gives to a flooded one; and the cells behind a receding meniscus."""
+    cell gives to a flooded one; and the cells behind a receding meniscus.
+
+    Off the flooded cells' bounding box and a cell round it, no face has a flooded side
+    and no cell a flooded neighbour: there the walls carry each cell's oil on through its
+    x faces and nothing crosses the y faces, the same sums in a loop without the tests."""
     ny, nx = flooded.shape
     qx = np.empty((ny, nx - 1))
     qy = np.empty((ny - 1, nx))
     draw_x = np.zeros((ny, nx - 1), np.bool_)
     draw_y = np.zeros((ny - 1, nx), np.bool_)
     layer = np.zeros((ny, nx), np.bool_)
+    i0, i1, j0, j1 = _bounds(flooded)
+    i0, i1, j0, j1 = max(i0 - 1, 0), min(i1 + 1, ny - 1), max(j0 - 1, 0), min(j1 + 1, nx - 1)
     for i in range(ny):
         for j in range(nx - 1):
+            if i < i0 or i > i1 or j < j0 or j > j1:
+                qx[i, j] = 0.0 + u * c[i, j] * d * (1.0 if gx[i, j] > 0 else 0.0)
+                continue
             fl, fr = flooded[i, j], flooded[i, j + 1]
             touch = False
             if not fl and not island[i, j] and not cavity[i, j]:
@@ -226,6 +231,9 @@ def face_fluxes(flooded, p, c, cavity, island, cap, film, hx_m, gx, gy, cx, mgx,
             draw_x[i, j] = (not fl and fr and q > 0) or (fl and not fr and q < 0)
     for i in range(ny - 1):
         for j in range(nx):
+            if i < i0 or i > i1 or j < j0 or j > j1:
+                qy[i, j] = 0.0
+                continue
             lo, hi = flooded[i, j], flooded[i + 1, j]
             q = _poiseuille(lo, hi, p[i, j], p[i + 1, j], gy[i, j], mgy[i, j], mpy[i, j])
             qy[i, j] = q

@@ -181,15 +181,24 @@ def fill(c, h, layers, cavity):
     the room ``h - layers`` for it; in a ``cavity`` cell, ``c / h``."""
     ny, nx = c.shape
     out = np.empty((ny, nx))
-    for i in range(ny):
-        for j in range(nx):
+    fill_into(out, c, h, layers, cavity, 0, ny - 1, 0, nx - 1, 0.0)
+    return out
+
+
+@njit(cache=True)
+def fill_into(out, c, h, layers, cavity, i0, i1, j0, j1, plus):
+    """:func:`fill` into ``out`` on rows ``i0``-``i1`` and columns ``j0``-``j1``
+    (inclusive), in place, ``plus`` added unless it is 0 (so that a fill of -0 stays
+    one)."""
+    for i in range(i0, i1 + 1):
+        for j in range(j0, j1 + 1):
             if cavity[i, j]:
                 v = c[i, j] / (h[i, j] if h[i, j] > 0 else 1.0)
             else:
                 room = h[i, j] - layers[i, j]
                 v = (c[i, j] - layers[i, j]) / (room if room > 0 else 1.0)
-            out[i, j] = min(max(v, 0.0), 1.0)
-    return out
+            v = min(max(v, 0.0), 1.0)
+            out[i, j] = plus + v if plus != 0.0 else v
 
 
 @njit(cache=True)

@@ -20,8 +20,9 @@ import numpy as np
 from numba import njit
 
 from ehlfoam.thinfilm.flux_kernels import face_fluxes, hold_back
-from ehlfoam.thinfilm.kernels import (_grow, band_cholesky_solve, edge_connected, fill,
-                                      meniscus_faces, pressure_on_grid, pressure_system)
+from ehlfoam.thinfilm.kernels import (_bounds, _grow, band_cholesky_solve, edge_connected,
+                                      fill_into, meniscus_faces, pressure_on_grid,
+                                      pressure_system)
 
 #: how a pass ended: the banded solve refused the system (sparse LU in Python), cells below
 #: the cavitation pressure opened to gas, flooded cells that would run dry opened, or the
@@ -86,11 +87,15 @@ def open_cells(flooded, island, closed_side, before, has_before):
 def menisci(flooded, c, cavity, factor, gas, has_gas, k):
     """The faces' menisci, x faces then y faces: the flooded cell's conductance to the
     meniscus, its pressure [Pa] and (x faces) the gap there [m]
-    (:meth:`ehlfoam.thinfilm.operators.Operators.menisci`; ``k``: :class:`PassConstants`)."""
+    (:meth:`ehlfoam.thinfilm.operators.Operators.menisci`; ``k``: :class:`PassConstants`).
+    The menisci's cells (theta: 1/2 + their fill, sub-cell) are read only on the flooded
+    cells' bounding box and a cell round it, where the faces with a flooded side are."""
+    theta = np.ones_like(c)
     if k.sub_cell:
-        theta = 0.5 + fill(c, k.h, k.layers, cavity)
-    else:
-        theta = np.ones_like(c)
+        ny, nx = c.shape
+        i0, i1, j0, j1 = _bounds(flooded)
+        fill_into(theta, c, k.h, k.layers, cavity, max(i0 - 1, 0), min(i1 + 1, ny - 1),
+                  max(j0 - 1, 0), min(j1 + 1, nx - 1), 0.5)
     gmx, pmx, hmx = meniscus_faces(flooded, theta, k.h, factor, k.young_laplace, k.gx,
                                    cavity, gas, k.p_cav, k.has_cav, has_gas, 1)
     gmy, pmy, _ = meniscus_faces(flooded, theta, k.h, factor, k.young_laplace, k.gy,
