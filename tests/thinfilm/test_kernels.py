@@ -242,3 +242,16 @@ def test_the_hold_back_reads_the_net_inflow_anew_only_where_the_fluxes_changed()
             assert np.array_equal(a, b) and np.array_equal(np.signbit(a), np.signbit(b))
         drawn += int(np.any(got[0] > qx))
     assert drawn > 20                                  # films were drawn on many grids
+
+
+def test_the_bounding_box_is_that_of_the_flooded_cells():
+    """The kernels' bounding box of the flooded cells (rows and columns, inclusive; empty
+    ranges without one) is that of numpy's nonzero, on random grids sparse and empty."""
+    from ehlfoam.thinfilm.kernels import _bounds
+    rng = np.random.default_rng(5)
+    for _ in range(500):
+        mask = rng.uniform(size=rng.integers(1, 25, size=2)) < rng.uniform(0.0, 0.1)
+        rows, cols = np.nonzero(mask)
+        want = (0, -1, 0, -1) if rows.size == 0 else \
+            (rows.min(), rows.max(), cols.min(), cols.max())
+        assert _bounds(mask) == want

@@ -21,17 +21,32 @@ _BIG = float(np.finfo(np.float64).max)     # np.nan_to_num's stand-in for inf
 def _bounds(flooded):
     """The first and last rows and columns that hold a flooded cell, ``(i0, i1, j0, j1)``
     (inclusive; ``(0, -1, 0, -1)``, empty ranges, without one): the region's bounding box,
-    outside which the menisci and the pressure system have nothing to do."""
+    outside which the menisci and the pressure system have nothing to do. (Which rows and
+    columns hold one, by or-ing without a test a cell, then the first and last of each.)"""
     ny, nx = flooded.shape
-    i0, i1, j0, j1 = ny, -1, nx, -1
+    rows = np.zeros(ny, np.bool_)
+    cols = np.zeros(nx, np.bool_)
     for i in range(ny):
+        row = False
         for j in range(nx):
-            if flooded[i, j]:
-                i0, i1 = min(i0, i), max(i1, i)
-                j0, j1 = min(j0, j), max(j1, j)
-    if i1 < 0:
+            f = flooded[i, j]
+            row |= f
+            cols[j] |= f
+        rows[i] = row
+    if not rows.any():
         return 0, -1, 0, -1
+    i0, i1, j0, j1 = _first(rows), ny - 1 - _first(rows[::-1]), _first(cols), \
+        nx - 1 - _first(cols[::-1])
     return i0, i1, j0, j1
+
+
+@njit(cache=True)
+def _first(flags):
+    """The index of the first True in ``flags`` (one there is)."""
+    for k in range(flags.size):
+        if flags[k]:
+            return k
+    return flags.size
 
 
 @njit(cache=True)
