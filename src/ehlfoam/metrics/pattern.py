@@ -71,13 +71,22 @@ def _edge_mask(shape: tuple[int, int]) -> np.ndarray:
     return edge
 
 
+@njit(cache=True)
 def _touching(labels: np.ndarray, count: int, where: np.ndarray) -> np.ndarray:
     """The pixels of the labelled regions (``labels`` 1..``count``, 0 outside them) that
     have a pixel in ``where``."""
-    hit = np.zeros(count + 1, dtype=bool)
-    hit[labels[where]] = True
+    ny, nx = labels.shape
+    hit = np.zeros(count + 1, np.bool_)
+    for i in range(ny):
+        for j in range(nx):
+            if where[i, j]:
+                hit[labels[i, j]] = True
     hit[0] = False
-    return hit[labels]
+    out = np.empty((ny, nx), np.bool_)
+    for i in range(ny):
+        for j in range(nx):
+            out[i, j] = hit[labels[i, j]]
+    return out
 
 
 def _outer_air(labels: np.ndarray, count: int) -> tuple[np.ndarray, int]:
