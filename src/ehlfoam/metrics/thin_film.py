@@ -30,9 +30,17 @@ def _outside_island(values: np.ndarray, island: np.ndarray) -> np.ndarray:
     interpolation next to the rim reads the cells there, not across the island)."""
     if not island.any() or island.all():
         return values
-    nearest = ndimage.distance_transform_edt(island, return_distances=False,
+    return values[_nearest_outside(island.shape, island.tobytes())]
+
+
+@functools.lru_cache(maxsize=8)
+def _nearest_outside(shape: tuple[int, int], island: bytes) -> tuple[np.ndarray, np.ndarray]:
+    """Each cell's nearest cell off the island (the island's cells packed in ``island``):
+    the same at every reading of a run."""
+    mask = np.frombuffer(island, dtype=bool).reshape(shape)
+    nearest = ndimage.distance_transform_edt(mask, return_distances=False,
                                              return_indices=True)
-    return values[tuple(nearest)]
+    return nearest[0], nearest[1]
 
 
 def _linear_weights(src: np.ndarray, dst: np.ndarray) -> csr_matrix:
@@ -44,6 +52,16 @@ def _linear_weights(src: np.ndarray, dst: np.ndarray) -> csr_matrix:
     return csr_matrix((np.concatenate([1.0 - t, t]),
                        (np.concatenate([rows, rows]), np.concatenate([k, k + 1]))),
                       shape=(len(dst), len(src)))
+
+
+@functools.lru_cache(maxsize=8)
+def _weights(y: bytes, x: bytes, ys: bytes, xs: bytes) -> tuple[csr_matrix, csr_matrix]:
+    """The bilinear map's two one-dimensional weights from the cell centres ``y``, ``x``
+    to the pixel centres ``ys``, ``xs`` (float64 arrays packed as bytes; the pixels beyond
+    the outer centres take the edge cells' values): the same at every reading of a run."""
+    y, x, ys, xs = (np.frombuffer(b) for b in (y, x, ys, xs))
+    return (_linear_weights(y, np.clip(ys, y[0], y[-1])),
+            _linear_weights(x, np.clip(xs, x[0], x[-1])))
 
 
 @functools.lru_cache(maxsize=8)
@@ -70,8 +88,7 @@ def thin_film_raster(sol: ThinFilmSolution, geom: Geometry,
                                          else DEFAULT_CELL_OVER_A * geom.a))
     # bilinear on the regular grid, as two sparse one-dimensional linear maps (a small
     # share of a point-by-point interpolator's cost: the run reads its oil a few times a transit)
-    wy = _linear_weights(y, np.clip(ys, y[0], y[-1]))
-    wx = _linear_weights(grid.x, np.clip(xs, grid.x[0], grid.x[-1]))
+    wy, wx = _weights(y.tobytes(), grid.x.tobytes(), ys.tobytes(), xs.tobytes())
     values = np.clip(np.asarray(wy @ np.vstack([alpha[::-1], alpha]) @ wx.T), 0, 1)
     values[island] = np.nan
     return Raster(x=xs, y=ys, alpha=values, island=island, geom=geom)

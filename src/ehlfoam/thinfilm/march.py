@@ -239,8 +239,8 @@ class Marcher:
         self.oil_out_rows += s.outlet_rows * dt
         self.oil_out_side += s.q_side * dt
         self._out += (s.q_outlet + s.q_side) * dt
-        self._dry += int(s.opened.sum())
-        self._cavitated += int(s.cavitated.sum())
+        self._dry += int(np.count_nonzero(s.opened))
+        self._cavitated += int(np.count_nonzero(s.cavitated))
 
     def _record(self) -> dict:
         """The transit just marched: its time [s], the region's oil [m3, half domain], its
