@@ -11,7 +11,10 @@ of cases, a report (``write_report``)::
     print(metrics["state"], metrics["inlet_meniscus_distance_over_a"])
 
 SI units throughout (lengths in m, speeds in m/s; ``_over_a``: in Hertz radii). Names load on
-first use (PEP 562), so ``import ehlfoam`` is quick and changes nothing.
+first use (PEP 562), so ``import ehlfoam`` is quick. It changes one thing: unless
+``NUMBA_CACHE_DIR`` is set, it points numba's cache at a folder per version of the package's
+kernels (:mod:`ehlfoam._kernel_cache`: numba would otherwise keep running a kernel's old
+callees from other files after an update).
 """
 
 from __future__ import annotations
@@ -20,6 +23,8 @@ import os
 from importlib import import_module
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from ehlfoam._kernel_cache import use_kernel_cache_dir
 
 if TYPE_CHECKING:
     from ehlfoam.batch.launch import BatchOutcome
@@ -43,6 +48,9 @@ _REEXPORTED = {
     "run_case": ("ehlfoam.run.monitor", "run_case"),
     "write_report": ("ehlfoam.report", "report"),
 }
+
+
+use_kernel_cache_dir()
 
 
 def __getattr__(name: str) -> Any:

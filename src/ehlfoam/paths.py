@@ -2,7 +2,8 @@
 the checks of a path a user gives it to write into, made before any work.
 
 ``$EHLFOAM_CACHE``, else ``${XDG_CACHE_HOME:-$HOME/.cache}/ehlfoam``. It holds the embedded
-OpenFOAM runtime (``openfoam-trixie/``) and the EHL precalcs (``precalc/<key>/``).
+OpenFOAM runtime (``openfoam-trixie/``), the EHL precalcs (``precalc/<key>/``) and the
+compiled numba kernels (``numba/<hash>/``, :mod:`ehlfoam._kernel_cache`).
 ``tools/ensure-env`` asks this module for the folder (``python -m ehlfoam.paths``), so the
 shell and Python cannot disagree.
 
