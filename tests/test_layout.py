@@ -28,7 +28,7 @@ PACKAGE = SRC / "ehlfoam"
 #: below its own, never from one above. The top-level modules not named here
 #: (``ehlfoam/__init__.py``, ``ehlfoam/__main__.py``) sit on top of everything.
 LAYERS: list[tuple[str, ...]] = [
-    ("_io", "errors", "notices", "paths"),
+    ("_io", "_cache_root", "_kernel_cache", "errors", "notices", "paths"),
     ("foam",),
     ("contact",),
     ("spec",),

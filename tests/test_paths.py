@@ -24,9 +24,10 @@ def test_cache_dir_rule() -> None:
 
 def test_the_module_prints_the_rule_for_the_shell_and_ensure_env_uses_it() -> None:
     env = {"HOME": "/h", "XDG_CACHE_HOME": "/x", "PATH": "/usr/bin:/bin"}
-    out = subprocess.run([sys.executable, "-m", "ehlfoam.paths"], env=env, text=True,
-                         capture_output=True, check=True).stdout.strip()
-    assert out == "/x/ehlfoam"
+    run = subprocess.run([sys.executable, "-m", "ehlfoam.paths"], env=env, text=True,
+                         capture_output=True, check=True)
+    assert run.stdout.strip() == "/x/ehlfoam"
+    assert run.stderr == ""        # the package's import did not load the module run
     assert '"$VPY" -m ehlfoam.paths' in (ROOT / "tools" / "ensure-env").read_text()
 
 

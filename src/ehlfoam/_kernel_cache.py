@@ -15,7 +15,7 @@ import os
 import sys
 from pathlib import Path
 
-from ehlfoam.paths import cache_dir
+from ehlfoam._cache_root import cache_dir
 
 #: the package's root folder, whose numba modules are hashed
 _ROOT = Path(__file__).resolve().parent

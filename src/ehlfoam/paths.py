@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import errno
 import os
-from collections.abc import Mapping
 from pathlib import Path
+
+from ehlfoam._cache_root import cache_dir
 
 __all__ = ["FOAM_PATH_SYNTAX", "MIN_FREE_BYTES", "cache_dir", "check_case_out",
            "check_foam_path", "check_output", "foam_path_problem"]
@@ -32,16 +33,6 @@ MIN_FREE_BYTES = 1 << 20
 #: whitespace and quotes, and turns a backslash into '/'): the shell's syntax in the case's
 #: scripts and OpenFOAM's wildcards, $-expansion and dictionary braces.
 FOAM_PATH_SYNTAX = "*?[]{}$;<>|&`"
-
-
-def cache_dir(environ: Mapping[str, str] | None = None) -> Path:
-    """The per-machine cache folder (not created here)."""
-    env = os.environ if environ is None else environ
-    if env.get("EHLFOAM_CACHE"):
-        return Path(env["EHLFOAM_CACHE"]).expanduser()
-    home = env.get("HOME") or str(Path.home())
-    xdg = env.get("XDG_CACHE_HOME") or str(Path(home) / ".cache")
-    return Path(xdg).expanduser() / "ehlfoam"
 
 
 if __name__ == "__main__":
