@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ehlfoam.thinfilm.kernels import _bounds
+from ehlfoam.thinfilm.kernels import _bounds_around
 
 
 @njit(cache=True)
@@ -208,8 +208,7 @@ def face_fluxes(flooded, p, c, cavity, island, cap, film, hx_m, gx, gy, cx, mgx,
     draw_x = np.zeros((ny, nx - 1), np.bool_)
     draw_y = np.zeros((ny - 1, nx), np.bool_)
     layer = np.zeros((ny, nx), np.bool_)
-    i0, i1, j0, j1 = _bounds(flooded)
-    i0, i1, j0, j1 = max(i0 - 1, 0), min(i1 + 1, ny - 1), max(j0 - 1, 0), min(j1 + 1, nx - 1)
+    i0, i1, j0, j1 = _bounds_around(flooded)
     for i in range(ny):
         for j in range(nx - 1):
             if i < i0 or i > i1 or j < j0 or j > j1:

@@ -41,6 +41,16 @@ def _bounds(flooded):
 
 
 @njit(cache=True)
+def _bounds_around(flooded):
+    """:func:`_bounds` grown by a cell on each side, within the grid: the cells that are
+    flooded or have a flooded 4-neighbour, and the faces with a flooded side, lie in it
+    (``(0, 0, 0, 0)`` without a flooded cell)."""
+    ny, nx = flooded.shape
+    i0, i1, j0, j1 = _bounds(flooded)
+    return max(i0 - 1, 0), min(i1 + 1, ny - 1), max(j0 - 1, 0), min(j1 + 1, nx - 1)
+
+
+@njit(cache=True)
 def _first(flags):
     """The index of the first True in ``flags`` (one there is)."""
     for k in range(flags.size):

@@ -20,9 +20,9 @@ import numpy as np
 from numba import njit
 
 from ehlfoam.thinfilm.flux_kernels import face_fluxes, hold_back
-from ehlfoam.thinfilm.kernels import (_bounds, _grow, band_cholesky_solve, edge_connected,
-                                      fill_into, meniscus_faces, pressure_on_grid,
-                                      pressure_system)
+from ehlfoam.thinfilm.kernels import (_bounds_around, band_cholesky_solve, edge_connected,
+                                      edge_connected_from, fill_into, meniscus_faces,
+                                      pressure_on_grid, pressure_system)
 
 #: how a pass ended: the banded solve refused the system (sparse LU in Python), cells below
 #: the cavitation pressure opened to gas, flooded cells that would run dry opened, or the
@@ -74,7 +74,7 @@ def open_cells(flooded, island, closed_side, before, has_before):
     for i in range(ny):
         for j in range(nx):
             gas[i, j] = not flooded[i, j] and not island[i, j]
-    outer = _grow(gas, closed_side, before.copy()) if has_before \
+    outer = edge_connected_from(gas, closed_side, before) if has_before \
         else edge_connected(gas, closed_side)
     cavity = np.empty((ny, nx), np.bool_)
     for i in range(ny):
@@ -92,10 +92,7 @@ def menisci(flooded, c, cavity, factor, gas, has_gas, k):
     cells' bounding box and a cell round it, where the faces with a flooded side are."""
     theta = np.ones_like(c)
     if k.sub_cell:
-        ny, nx = c.shape
-        i0, i1, j0, j1 = _bounds(flooded)
-        fill_into(theta, c, k.h, k.layers, cavity, max(i0 - 1, 0), min(i1 + 1, ny - 1),
-                  max(j0 - 1, 0), min(j1 + 1, nx - 1), 0.5)
+        fill_into(theta, c, k.h, k.layers, cavity, *_bounds_around(flooded), 0.5)
     gmx, pmx, hmx = meniscus_faces(flooded, theta, k.h, factor, k.young_laplace, k.gx,
                                    cavity, gas, k.p_cav, k.has_cav, has_gas, 1)
     gmy, pmy, _ = meniscus_faces(flooded, theta, k.h, factor, k.young_laplace, k.gy,
