@@ -373,3 +373,24 @@ def test_flooded_widths_at_follow_a_known_outline():
     error = np.abs(np.array(widths[:-1]) / A - expected)
     assert np.all(error <= 2 * TOL + slope * r.dx / A / 2), error
     assert widths[1] / A == pytest.approx(pattern(ring)["flooded_width_over_a"], abs=TOL)
+
+
+def test_the_extents_across_the_rows_are_those_of_the_transposed_picture():
+    """The extents along the rows (axis 0, read row by row) are bitwise those read along
+    the columns of the transposed picture, crossings and signed coordinates included; the
+    mean leaving NaN out is numpy's nanmean bitwise, with and without NaN."""
+    from ehlfoam.metrics.pattern import _extent, _mean
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        ny, nx = rng.integers(2, 30, size=2)
+        alpha = rng.uniform(0.0, 1.0, (ny, nx))
+        region = alpha >= 0.5
+        region[rng.integers(ny), rng.integers(nx)] = True
+        gas = ~region & (rng.uniform(size=(ny, nx)) < 0.8)
+        y = np.sort(rng.normal(0.0, 1e-3, ny))
+        assert _extent(region, alpha, gas, y, 0.5, axis=0) == _extent(region.T, alpha.T,
+                                                                     gas.T, y, 0.5)
+        values = alpha.ravel()
+        assert _mean(values) == np.nanmean(values)
+        values[rng.integers(values.size)] = np.nan
+        assert _mean(values) == np.nanmean(values)

@@ -116,39 +116,62 @@ def _crossing(x0: float, a0: float, x1: float, a1: float, threshold: float) -> f
 
 @njit(cache=True)
 def _far_extent(region: np.ndarray, alpha: np.ndarray, gas: np.ndarray,
-                coords: np.ndarray, threshold: float) -> float:
-    """Largest coordinate of ``region`` (not empty) along axis 1 (ascending ``coords``).
+                coords: np.ndarray, threshold: float, axis: int) -> float:
+    """Largest coordinate of ``region`` (not empty) along ``axis`` (0: rows, 1: columns;
+    ascending ``coords``), read row by row whichever the axis (no transposed walk).
 
-    A region pixel whose next pixel is gas extends to the interpolated
+    A region pixel whose next pixel along the axis is gas extends to the interpolated
     ``alpha = threshold`` crossing between the two (the fraction of the step clipped to
     0-1; 0 where it is not a number).
     """
     best = -np.inf
     ny, nx = region.shape
+    di, dj = (1, 0) if axis == 0 else (0, 1)
     for i in range(ny):
         for j in range(nx):
             if not region[i, j]:
                 continue
-            reach = coords[j]
-            if j + 1 < nx and gas[i, j + 1]:
-                num, den = alpha[i, j] - threshold, alpha[i, j] - alpha[i, j + 1]
+            k = i if axis == 0 else j
+            reach = coords[k]
+            ii, jj = i + di, j + dj
+            if ii < ny and jj < nx and gas[ii, jj]:
+                num, den = alpha[i, j] - threshold, alpha[i, j] - alpha[ii, jj]
                 if den != 0.0:
                     frac = num / den
                 else:
                     frac = 1.0 if num > 0.0 else 0.0
                 frac = 0.0 if not frac >= 0.0 else min(frac, 1.0)
-                reach = coords[j] + frac * (coords[j + 1] - coords[j])
+                reach = coords[k] + frac * (coords[k + 1] - coords[k])
             best = max(best, reach)
     return best
 
 
 def _extent(region: np.ndarray, alpha: np.ndarray, gas: np.ndarray,
-            coords: np.ndarray, threshold: float) -> tuple[float, float]:
-    """(min, max) coordinate of ``region`` along axis 1, sub-pixel."""
-    hi = _far_extent(region, alpha, gas, np.asarray(coords, dtype=float), threshold)
-    lo = -_far_extent(region[:, ::-1], alpha[:, ::-1], gas[:, ::-1],
-                      -np.asarray(coords, dtype=float)[::-1], threshold)
+            coords: np.ndarray, threshold: float, axis: int = 1) -> tuple[float, float]:
+    """(min, max) coordinate of ``region`` along ``axis`` (``coords`` its pixels'), sub-pixel."""
+    coords = np.asarray(coords, dtype=float)
+    hi = _far_extent(region, alpha, gas, coords, threshold, axis)
+    flip = (slice(None, None, -1), slice(None)) if axis == 0 else (slice(None), slice(None, None, -1))
+    lo = -_far_extent(region[flip], alpha[flip], gas[flip], -coords[::-1], threshold, axis)
     return lo, hi
+
+
+@njit(cache=True)
+def _walk_upstream(x: np.ndarray, island: np.ndarray, region: np.ndarray) -> tuple[int, int]:
+    """On one row (pixel centres ``x`` ascending, its ``island`` and ``region`` pixels): the
+    last pixel upstream of the island (x < 0, not island) and, walking upstream from it
+    through ``region``, the first pixel outside it; -1 for either where there is none (no
+    walk when the first is not in ``region``)."""
+    start = -1
+    for j in range(x.size):
+        if x[j] < 0.0 and not island[j]:
+            start = j
+    if start < 0 or not region[start]:
+        return start, -1
+    for j in range(start, -1, -1):
+        if not region[j]:
+            return start, j
+    return start, -1
 
 
 def _upstream_meniscus(r: Raster, row: int, region: np.ndarray, threshold: float) -> tuple[float | None, bool]:
@@ -161,17 +184,14 @@ def _upstream_meniscus(r: Raster, row: int, region: np.ndarray, threshold: float
     position ``-sqrt(R^2 - y^2)`` (0 beyond the island) and True. Returns
     (None, False) when ``region`` reaches the inlet edge.
     """
-    upstream = np.flatnonzero((r.x < 0.0) & ~r.island[row])
-    if upstream.size == 0:
+    start, k = _walk_upstream(r.x, r.island[row], region[row])
+    if start < 0:
         return None, False
-    start = int(upstream[-1])
     if not region[row, start]:
         rim = -math.sqrt(max(r.geom.island_radius**2 - float(r.y[row]) ** 2, 0.0))
         return rim, True
-    outside = np.flatnonzero(~region[row, : start + 1])
-    if outside.size == 0:
+    if k < 0:
         return None, False
-    k = int(outside[-1])
     alpha = r.alpha[row]
     return _crossing(r.x[k], alpha[k], r.x[k + 1], alpha[k + 1], threshold), False
 
@@ -235,7 +255,7 @@ def _bubble(r: Raster, outer: np.ndarray, bubble: np.ndarray, oil: np.ndarray,
                 "bubble_enclosed": False}
     alpha = r.alpha
     _, tip = _extent(bubble, alpha, oil, r.x, threshold)
-    y_lo, y_hi = _extent(bubble.T, alpha.T, oil.T, r.y, threshold)
+    y_lo, y_hi = _extent(bubble, alpha, oil, r.y, threshold, axis=0)
     return {"bubble_length_over_a": max(0.0, float((tip - a) / a)),
             "bubble_width_over_a": float((y_hi - y_lo) / a),
             "bubble_enclosed": not bool((bubble & outer).any())}
@@ -301,7 +321,7 @@ def pattern_and_bubble(r: Raster, threshold: float = 0.5) -> tuple[dict[str, Any
     if flooded.any():
         alpha = r.alpha             # read on the region and the gas only: no NaN
         x_lo, x_hi = _extent(flooded, alpha, gas, r.x, threshold)
-        y_lo, y_hi = _extent(flooded.T, alpha.T, gas.T, r.y, threshold)
+        y_lo, y_hi = _extent(flooded, alpha, gas, r.y, threshold, axis=0)
         length, width = float((x_hi - x_lo) / a), float((y_hi - y_lo) / a)
         # the flooded region's distance to each open boundary (the raster is the full,
         # mirrored domain: the side edges are at -y_max and y_max)
@@ -334,8 +354,15 @@ def pattern_and_bubble(r: Raster, threshold: float = 0.5) -> tuple[dict[str, Any
         "enclosed_bubbles": enclosed,
         **_bubble(r, outer, bubble, oil, threshold),
         "oil_area_fraction": float(oil.sum() / free.sum()),
-        "mean_alpha": float(np.nanmean(r.alpha[free])),
+        "mean_alpha": _mean(r.alpha[free]),
     }, bubble)
+
+
+def _mean(values: np.ndarray) -> float:
+    """The mean of ``values`` leaving NaN out: :func:`numpy.nanmean`'s, bitwise, at a fifth of
+    its cost where there is no NaN (the pixels off the island of a raster)."""
+    mean = float(values.mean())
+    return float(np.nanmean(values)) if math.isnan(mean) else mean
 
 
 def flow_pattern(x: Any, y: Any, alpha: Any, geom: Geometry, threshold: float = 0.5,
