@@ -217,7 +217,8 @@ def _net_inflow(qx, qy, q_last, q_side, q_supply):
 def test_the_hold_back_reads_the_net_inflow_anew_only_where_the_fluxes_changed():
     """The hold-back reads the net inflow anew only where the fluxes changed (beside the
     films drawn from a cell): bitwise what reading it anew over the whole grid each time
-    gives, on grids where open cells run short and films are drawn."""
+    gives, on grids where open cells run short and films are drawn (from any column on: the
+    cells before the first films' are read again too)."""
     from ehlfoam.thinfilm.flux_kernels import hold_back, net_inflow
     rng = np.random.default_rng(11)
     drawn = 0
@@ -233,6 +234,7 @@ def test_the_hold_back_reads_the_net_inflow_anew_only_where_the_fluxes_changed()
         draw_x = rng.uniform(size=(ny, nx - 1)) < 0.3
         draw_y = rng.uniform(size=(ny - 1, nx)) < 0.3
         layer = (rng.uniform(size=(ny, nx)) < 0.4) & ~flooded
+        layer[:, :rng.integers(0, nx)] = False         # films from any column on
         qx[rng.uniform(size=qx.shape) < 0.2] = 0.0     # zeros, whose sign may change
         args = (qx, qy, q_last, q_side, q_supply, c, 1.0, 1.0, flooded, island, draw_x,
                 draw_y, layer, -1e-12 * np.ones((ny, nx)))

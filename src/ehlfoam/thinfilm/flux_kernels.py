@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ehlfoam.thinfilm.kernels import _bounds_around
+from ehlfoam.thinfilm.kernels import _bounds, _bounds_around
 
 
 @njit(cache=True)
@@ -28,14 +28,17 @@ def net_inflow(qx, qy, q_last, q_side, q_supply):
 
 
 @njit(cache=True)
-def _read(qx, qy, q_last, q_side, q_supply, net, held, short_at, opn, cut, cells, every):
-    """Every cell's net inflow [m3/s] into ``net`` (only those of ``cells`` unless
-    ``every``), in place, and whether it leaves an open cell (``opn``) short (its oil
-    ``held`` plus its net inflow below ``short_at``, all [m3/s] over the step) into
-    ``cut``; returns how many cells are short then, all over the grid."""
+def _read(qx, qy, q_last, q_side, q_supply, net, held, short_at, opn, cut, cells, every,
+          box=(0, -1, 0, -1)):
+    """Every cell's net inflow [m3/s] into ``net`` (only those of ``cells``, all in ``box``,
+    rows and columns ``(i0, i1, j0, j1)`` inclusive, unless ``every``), in place, and
+    whether it leaves an open cell (``opn``) short (its oil ``held`` plus its net inflow
+    below ``short_at``, all [m3/s] over the step) into ``cut``; returns how many cells are
+    short then, all over the grid."""
     ny, nx = net.shape
-    for i in range(ny):
-        for j in range(nx):
+    i0, i1, j0, j1 = (0, ny - 1, 0, nx - 1) if every else box
+    for i in range(i0, i1 + 1):
+        for j in range(j0, j1 + 1):
             if not every and not cells[i, j]:
                 continue
             v = 0.0
@@ -121,14 +124,16 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
     n_short = _read(qx, qy, q_last, q_side, *state, cut, True)
     n_short = _rounds(qx, qy, q_last, q_side, state, n_short, draw_x, draw_y, False)
     touched = np.zeros((ny, nx), np.bool_)
-    for i in range(ny):
-        for j in range(1, nx):
+    i0, i1, j0, j1 = _bounds(layer)             # the films' cells, and the cells before them
+    j0 = max(j0 - 1, 0)
+    for i in range(i0, i1 + 1):
+        for j in range(max(j0, 1), j1 + 1):
             if layer[i, j] and opn[i, j]:
                 before = qx[i, j - 1]
                 qx[i, j - 1] += max(-(held[i, j] + net[i, j]), 0.0)
                 if qx[i, j - 1] != before or before == 0.0:   # a zero may change its sign
                     touched[i, j - 1] = touched[i, j] = True
-    n_short = _read(qx, qy, q_last, q_side, *state, touched, False)
+    n_short = _read(qx, qy, q_last, q_side, *state, touched, False, (i0, i1, j0, j1))
     _rounds(qx, qy, q_last, q_side, state, n_short, draw_x, draw_y, True)
     return qx, qy, q_last, q_side, net
 

@@ -191,9 +191,17 @@ def pressure_on_grid(idx, x):
     """The flooded cells' pressures ``x`` on the grid, each at its number ``idx`` (as
     :func:`pressure_system` numbers them; -1 elsewhere), NaN elsewhere."""
     ny, nx = idx.shape
+    return pressure_in_box(idx, x, 0, ny - 1, 0, nx - 1)
+
+
+@njit(cache=True)
+def pressure_in_box(idx, x, i0, i1, j0, j1):
+    """:func:`pressure_on_grid` with the numbered cells looked for on rows ``i0``-``i1`` and
+    columns ``j0``-``j1`` only (inclusive: a box that holds them all)."""
+    ny, nx = idx.shape
     p = np.full((ny, nx), np.nan)
-    for i in range(ny):
-        for j in range(nx):
+    for i in range(i0, i1 + 1):
+        for j in range(j0, j1 + 1):
             if idx[i, j] >= 0:
                 p[i, j] = x[idx[i, j]]
     return p

@@ -20,9 +20,9 @@ import numpy as np
 from numba import njit
 
 from ehlfoam.thinfilm.flux_kernels import face_fluxes, hold_back
-from ehlfoam.thinfilm.kernels import (_bounds_around, band_cholesky_solve, edge_connected,
+from ehlfoam.thinfilm.kernels import (_bounds, _bounds_around, band_cholesky_solve, edge_connected,
                                       edge_connected_from, fill_into, meniscus_faces,
-                                      pressure_on_grid, pressure_system)
+                                      pressure_in_box, pressure_system)
 
 #: how a pass ended: the banded solve refused the system (sparse LU in Python), cells below
 #: the cavitation pressure opened to gas, flooded cells that would run dry opened, or the
@@ -112,7 +112,7 @@ def flooded_pressure(flooded, c, dt, gmx, gmy, pmx, pmy, k, max_band):
         flooded, c, k.h, k.d, dt, k.u, k.gx, k.gy, k.cx, gmx, gmy, pmx, pmy, k.q_supply,
         k.g_side, k.g_out, k.cx_out)
     x, ok = band_cholesky_solve(data, indices, indptr, rhs, max_band)
-    p = pressure_on_grid(idx, x) if ok else np.full(flooded.shape, np.nan)
+    p = pressure_in_box(idx, x, *_bounds(flooded)) if ok else np.full(flooded.shape, np.nan)
     return p, ok, data, indices, indptr, rhs, idx
 
 
@@ -148,14 +148,15 @@ def after_pressure(flooded, p, c, dt, cavity, gmx, gmy, pmx, pmy, hmx, opened, c
     (:func:`moves`), and the flooded cells they would leave short of oil open (marked in
     ``opened``; :data:`RAN_DRY`), or the step is :data:`DONE`. Returns how it ended, the
     flooded cells after it (a new array where it opened some), and the moves (empty but on
-    :data:`DONE`)."""
+    :data:`DONE`). Both tests read the flooded cells' bounding box only."""
     ny, nx = flooded.shape
+    i0, i1, j0, j1 = _bounds(flooded)
     if k.has_cav:
         floor = k.p_cav - 1e-9 * abs(k.p_cav)
         low = np.zeros((ny, nx), np.bool_)
         found = False
-        for i in range(ny):
-            for j in range(nx):
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
                 if flooded[i, j] and p[i, j] < floor:
                     low[i, j] = True
                     found = True
@@ -165,8 +166,8 @@ def after_pressure(flooded, p, c, dt, cavity, gmx, gmy, pmx, pmy, hmx, opened, c
     dc, q_last, q_side = moves(flooded, p, c, dt, cavity, gmx, gmy, pmx, pmy, hmx, k)
     dry = np.zeros((ny, nx), np.bool_)
     found = False
-    for i in range(ny):
-        for j in range(nx):
+    for i in range(i0, i1 + 1):
+        for j in range(j0, j1 + 1):
             if flooded[i, j] and c[i, j] + dc[i, j] < 0.0:
                 dry[i, j] = True
                 found = True
@@ -179,9 +180,9 @@ def after_pressure(flooded, p, c, dt, cavity, gmx, gmy, pmx, pmy, hmx, opened, c
 def _opened(flooded, cells, marks):
     """``flooded`` without ``cells`` (a new array), ``cells`` marked in ``marks``."""
     out = flooded.copy()
-    ny, nx = flooded.shape
-    for i in range(ny):
-        for j in range(nx):
+    i0, i1, j0, j1 = _bounds(cells)
+    for i in range(i0, i1 + 1):
+        for j in range(j0, j1 + 1):
             if cells[i, j]:
                 out[i, j] = False
                 marks[i, j] = True
