@@ -16,7 +16,8 @@ from scipy.sparse.linalg import spsolve
 from ehlfoam.thinfilm.cavity import cavities_and_outer_air
 from ehlfoam.thinfilm.kernels import fill, pressure_on_grid
 from ehlfoam.thinfilm.pass_kernels import (DONE, NEEDS_LU, PassConstants, after_pressure,
-                                           flooded_pressure, menisci, one_pass)
+                                           flooded_pressure, menisci, one_pass,
+                                           passes)
 from ehlfoam.thinfilm.problem import Grid, ThinFilmProblem
 
 
@@ -86,7 +87,7 @@ class Operators:
         where the walls come in dry (off the track) and run into the meniscus at u m. So a
         meniscus at an angle to u is not left to the staircase of the cells; 1 with static
         menisci."""
-        if self.pull == 1.0 and self.theta_a is None:
+        if self.static_menisci:
             return 1.0
         phi = ndimage.gaussian_filter(flooded.astype(float), self.normal_sigma,
                                       mode="nearest")
@@ -158,8 +159,10 @@ class Operators:
         cells) for a set of cavity cells, where a gas balance sets them
         (:mod:`ehlfoam.thinfilm.gas`); None: at the cavitation pressure.
 
-        Each pass is one kernel (:func:`~ehlfoam.thinfilm.pass_kernels.one_pass`); the
-        oil's moves in it: the change of every cell's oil and the fluxes through the outlet
+        Each pass is one kernel (:func:`~ehlfoam.thinfilm.pass_kernels.one_pass`), and
+        without a gas balance, with static menisci, the passes are one call
+        (:func:`~ehlfoam.thinfilm.pass_kernels.passes`) but where sparse LU must solve
+        the pressure; the oil's moves in a pass: the change of every cell's oil and the fluxes through the outlet
         and the side. An open cell gives no more than it holds: what the flooded region
         draws from it is cut back first (the flooded cell runs short of a full gap), the
         films and layers it passes on only when that is not enough; a cavity's cells pass
@@ -168,16 +171,15 @@ class Operators:
         cavitated = np.zeros_like(flooded)
         outer = None        # the outer air of the last pass: each pass only opens cells
         for _ in range(1000):
-            if gas is None:
-                cavity, pressures = self._none, None
-            else:       # the gas balance's pressures are those of the cavities found
-                cavity, outer = self.open_cells(flooded, outer)
-                pressures = gas(cavity) if cavity.any() else None
-            status, flooded, cavity, found, p, dc, q_last, q_side, faces, system = one_pass(
-                flooded, c, dt, cavity, self._none if outer is None else outer, gas is None,
-                outer is not None, self._factor(flooded), *self._gas(pressures), opened,
-                cavitated, self.k, MAX_BAND)
-            if gas is None and self.p_cav is not None:
+            if gas is None and self.static_menisci:     # passes until done, in one call
+                status, flooded, cavity, found, p, dc, q_last, q_side, faces, system = \
+                    passes(flooded, c, dt, self._none if outer is None else outer,
+                           outer is not None, self._ones, opened, cavitated, self.k,
+                           MAX_BAND)
+            else:
+                status, flooded, cavity, found, p, dc, q_last, q_side, faces, system = \
+                    self._pass(flooded, c, dt, gas, outer, opened, cavitated)
+            if self.p_cav is not None:
                 outer = found
             if status == NEEDS_LU:
                 p = _by_lu(*system)
@@ -187,6 +189,26 @@ class Operators:
                 return Step(p, dc, float(q_last.sum()), float(q_side.sum()), opened,
                             cavitated, cavity, q_last)
         raise RuntimeError("the flooded set did not settle within a step")
+
+    def _pass(self, flooded: np.ndarray, c: np.ndarray, dt: float,
+              gas: Callable[[np.ndarray], np.ndarray] | None, outer: np.ndarray | None,
+              opened: np.ndarray, cavitated: np.ndarray) -> tuple:
+        """One pass of :meth:`step` (:func:`one_pass`), its menisci's factor and, with a gas
+        balance, the gas pressures of the cavities it finds, from Python."""
+        if gas is None:
+            cavity, pressures = self._none, None
+        else:           # the gas balance's pressures are those of the cavities found
+            cavity, outer = self.open_cells(flooded, outer)
+            pressures = gas(cavity) if cavity.any() else None
+        return one_pass(flooded, c, dt, cavity, self._none if outer is None else outer,
+                        gas is None, outer is not None, self._factor(flooded),
+                        *self._gas(pressures), opened, cavitated, self.k, MAX_BAND)
+
+    @property
+    def static_menisci(self) -> bool:
+        """Whether the menisci's factor is 1 everywhere (:meth:`pull_factor`): static
+        menisci, no advancing angle."""
+        return self.pull == 1.0 and self.theta_a is None
 
     def _factor(self, flooded: np.ndarray) -> np.ndarray:
         """The dynamic menisci's factor on every cell (:meth:`pull_factor`), as an array."""

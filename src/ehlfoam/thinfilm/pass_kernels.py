@@ -216,3 +216,25 @@ def one_pass(flooded, c, dt, cavity, outer, find_cells, has_before, factor, gas,
     status, flooded, dc, q_last, q_side = after_pressure(
         flooded, p, c, dt, cavity, gmx, gmy, pmx, pmy, hmx, opened, cavitated, k)
     return status, flooded, cavity, outer, p, dc, q_last, q_side, faces, system
+
+
+@njit(cache=True)
+def passes(flooded, c, dt, outer, has_before, factor, opened, cavitated, k, max_band):
+    """The passes of a step without a gas balance and with a menisci's factor that does not
+    change from pass to pass (the static menisci's), in one call: :func:`one_pass` after
+    :func:`one_pass` from ``flooded`` (``outer``: the outer air of the pass before, when
+    ``has_before``; each pass's cavities and outer air found anew, the outer air grown from
+    the last), until one ends :data:`DONE` or :data:`NEEDS_LU`, or 1000 passes. Returns
+    the last pass's :func:`one_pass` result: the same passes as one call a pass, without a
+    return to Python between them."""
+    none = np.zeros(flooded.shape, np.bool_)
+    result = one_pass(flooded, c, dt, none, outer, True, has_before, factor, k.h, False,
+                      opened, cavitated, k, max_band)
+    for _ in range(999):
+        if result[0] == DONE or result[0] == NEEDS_LU:
+            break
+        if k.has_cav:
+            outer, has_before = result[3], True
+        result = one_pass(result[1], c, dt, none, outer, True, has_before, factor, k.h,
+                          False, opened, cavitated, k, max_band)
+    return result
