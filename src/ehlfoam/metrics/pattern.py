@@ -151,7 +151,8 @@ def _extent(region: np.ndarray, alpha: np.ndarray, gas: np.ndarray,
     """(min, max) coordinate of ``region`` along ``axis`` (``coords`` its pixels'), sub-pixel."""
     coords = np.asarray(coords, dtype=float)
     hi = _far_extent(region, alpha, gas, coords, threshold, axis)
-    flip = (slice(None, None, -1), slice(None)) if axis == 0 else (slice(None), slice(None, None, -1))
+    flip = (slice(None, None, -1), slice(None)) if axis == 0 else \
+        (slice(None), slice(None, None, -1))
     lo = -_far_extent(region[flip], alpha[flip], gas[flip], -coords[::-1], threshold, axis)
     return lo, hi
 

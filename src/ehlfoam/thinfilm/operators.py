@@ -162,11 +162,12 @@ class Operators:
         Each pass is one kernel (:func:`~ehlfoam.thinfilm.pass_kernels.one_pass`), and
         without a gas balance, with static menisci, the passes are one call
         (:func:`~ehlfoam.thinfilm.pass_kernels.passes`) but where sparse LU must solve
-        the pressure; the oil's moves in a pass: the change of every cell's oil and the fluxes through the outlet
-        and the side. An open cell gives no more than it holds: what the flooded region
-        draws from it is cut back first (the flooded cell runs short of a full gap), the
-        films and layers it passes on only when that is not enough; a cavity's cells pass
-        on all the oil they hold, as no air meniscus holds it back."""
+        the pressure; the oil's moves in a pass: the change of every cell's oil and the
+        fluxes through the outlet and the side. An open cell gives no more than it holds:
+        what the flooded region draws from it is cut back first (the flooded cell runs
+        short of a full gap), the films and layers it passes on only when that is not
+        enough; a cavity's cells pass on all the oil they hold, as no air meniscus holds
+        it back."""
         opened = np.zeros_like(flooded)
         cavitated = np.zeros_like(flooded)
         outer = None        # the outer air of the last pass: each pass only opens cells

@@ -1,7 +1,8 @@
 """One pass of the thin-film step in one numba call: the cavities and the outer air, the
 menisci, the flooded cells' pressure, the test for cells below the cavitation pressure, the
 oil's moves and the test for cells run dry (:meth:`ehlfoam.thinfilm.operators.Operators.step`
-repeats passes until neither test opens a cell). The pass is the kernels of
+repeats passes until neither test opens a cell; :func:`passes` repeats them in one call where
+nothing between them needs Python). The pass is the kernels of
 :mod:`ehlfoam.thinfilm.kernels` and :mod:`ehlfoam.thinfilm.flux_kernels` in the order the
 step takes them, with the array expressions between them as loops: bitwise the same as
 calling them one by one from Python, without the returns to Python and the temporary arrays
@@ -20,9 +21,9 @@ import numpy as np
 from numba import njit
 
 from ehlfoam.thinfilm.flux_kernels import face_fluxes, hold_back
-from ehlfoam.thinfilm.kernels import (_bounds, _bounds_around, band_cholesky_solve, edge_connected,
-                                      edge_connected_from, fill_into, meniscus_faces,
-                                      pressure_in_box, pressure_system)
+from ehlfoam.thinfilm.kernels import (_bounds, _bounds_around, band_cholesky_solve,
+                                      edge_connected, edge_connected_from, fill_into,
+                                      meniscus_faces, pressure_in_box, pressure_system)
 
 #: how a pass ended: the banded solve refused the system (sparse LU in Python), cells below
 #: the cavitation pressure opened to gas, flooded cells that would run dry opened, or the
