@@ -141,16 +141,21 @@ def test_the_outer_air_grown_from_a_smaller_gas_is_the_outer_air_found_anew():
     assert joined > 10          # the new gas did join enclosed gas to the outer air
 
 
+def _bubble_behind_the_contact() -> ThinFilmProblem:
+    """A small problem whose march floods a region with a cavity behind the contact."""
+    return ThinFilmProblem(gap=lambda x, y: 1e-6 + (x**2 + y**2) / (2 * 0.01), speed=0.01,
+                           viscosity=0.02, surface_tension=0.03, contact_angle=15.0,
+                           supply=2e-6, track_half_width=3e-4, x_range=(-8 * A, 10 * A),
+                           y_max=8 * A, island_radius=A, cell=0.4 * A, initial_radius=6 * A,
+                           cavitation_pressure=-1e4)
+
+
 def test_a_march_is_the_same_whether_its_passes_solve_by_band_or_by_sparse_lu(monkeypatch):
     """The step's passes (one kernel each) go on from a pressure that sparse LU solved in
     Python where the band is refused: a march with a bubble behind the contact takes the
     same cells to flood, open and cavitate either way, its oil the same to round-off."""
     from ehlfoam.thinfilm.march import Marcher
-    prob = ThinFilmProblem(gap=lambda x, y: 1e-6 + (x**2 + y**2) / (2 * 0.01), speed=0.01,
-                           viscosity=0.02, surface_tension=0.03, contact_angle=15.0,
-                           supply=2e-6, track_half_width=3e-4, x_range=(-8 * A, 10 * A),
-                           y_max=8 * A, island_radius=A, cell=0.4 * A, initial_radius=6 * A,
-                           cavitation_pressure=-1e4)
+    prob = _bubble_behind_the_contact()
     runs = []
     for band in (operators.MAX_BAND, 0):
         monkeypatch.setattr(operators, "MAX_BAND", band)
@@ -172,11 +177,7 @@ def test_a_march_is_bitwise_the_same_with_its_passes_in_one_call_or_one_call_eac
     (pass_kernels.passes): a march with a bubble behind the contact is bitwise the one that
     calls one pass at a time from Python (as the gas balance and the dynamic menisci do)."""
     from ehlfoam.thinfilm.march import Marcher
-    prob = ThinFilmProblem(gap=lambda x, y: 1e-6 + (x**2 + y**2) / (2 * 0.01), speed=0.01,
-                           viscosity=0.02, surface_tension=0.03, contact_angle=15.0,
-                           supply=2e-6, track_half_width=3e-4, x_range=(-8 * A, 10 * A),
-                           y_max=8 * A, island_radius=A, cell=0.4 * A, initial_radius=6 * A,
-                           cavitation_pressure=-1e4)
+    prob = _bubble_behind_the_contact()
     runs = []
     for one_call in (True, False):
         monkeypatch.setattr(operators.Operators, "static_menisci",
