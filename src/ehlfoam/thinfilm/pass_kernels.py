@@ -229,13 +229,12 @@ def passes(flooded, c, dt, outer, has_before, factor, opened, cavitated, k, max_
     the last pass's :func:`one_pass` result: the same passes as one call a pass, without a
     return to Python between them."""
     none = np.zeros(flooded.shape, np.bool_)
-    result = one_pass(flooded, c, dt, none, outer, True, has_before, factor, k.h, False,
-                      opened, cavitated, k, max_band)
-    for _ in range(999):
+    for _ in range(1000):
+        result = one_pass(flooded, c, dt, none, outer, True, has_before, factor, k.h, False,
+                          opened, cavitated, k, max_band)
         if result[0] == DONE or result[0] == NEEDS_LU:
             break
+        flooded = result[1]
         if k.has_cav:
             outer, has_before = result[3], True
-        result = one_pass(result[1], c, dt, none, outer, True, has_before, factor, k.h,
-                          False, opened, cavitated, k, max_band)
     return result
