@@ -246,7 +246,7 @@ def test_the_hold_back_reads_the_net_inflow_anew_only_where_the_fluxes_changed()
     films drawn from a cell): bitwise what reading it anew over the whole grid each time
     gives, on grids where open cells run short and films are drawn (from any column on: the
     cells before the first films' are read again too)."""
-    from ehlfoam.thinfilm.flux_kernels import hold_back, net_inflow
+    from ehlfoam.thinfilm.flux_kernels import hold_back
     rng = np.random.default_rng(11)
     drawn = 0
     for _ in range(200):
@@ -266,7 +266,7 @@ def test_the_hold_back_reads_the_net_inflow_anew_only_where_the_fluxes_changed()
         args = (qx, qy, q_last, q_side, q_supply, c, 1.0, 1.0, flooded, island, draw_x,
                 draw_y, layer, -1e-12 * np.ones((ny, nx)))
         got, want = hold_back(*args), _hold_back_read_anew(*args)
-        assert np.array_equal(net_inflow(*got[:4], q_supply), want[4])
+        assert np.array_equal(_net_inflow(*got[:4], q_supply), want[4])
         for a, b in zip(got, want):
             assert np.array_equal(a, b) and np.array_equal(np.signbit(a), np.signbit(b))
         drawn += int(np.any(got[0] > qx))

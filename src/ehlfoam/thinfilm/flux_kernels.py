@@ -15,19 +15,6 @@ from ehlfoam.thinfilm.kernels import _bounds, _bounds_around
 
 
 @njit(cache=True)
-def net_inflow(qx, qy, q_last, q_side, q_supply):
-    """Net inflow of every cell [m3/s] from the face fluxes (lo -> hi: x faces (ny, nx - 1),
-    y faces (ny - 1, nx)), the supply into the first column and the outflow through the last
-    column and the side row."""
-    ny, nx = qy.shape[0] + 1, qx.shape[1] + 1
-    net, zero = np.empty((ny, nx)), np.zeros((ny, nx))
-    no_cells = np.zeros((ny, nx), np.bool_)
-    _read(qx, qy, q_last, q_side, q_supply, net, zero, zero, no_cells, no_cells.copy(),
-          no_cells, True)
-    return net
-
-
-@njit(cache=True)
 def _read(qx, qy, q_last, q_side, q_supply, net, held, short_at, opn, cut, cells, every,
           box=(0, -1, 0, -1)):
     """Every cell's net inflow [m3/s] into ``net`` (only those of ``cells``, all in ``box``,
@@ -100,7 +87,7 @@ def hold_back(qx, qy, q_last, q_side, q_supply, c, d, dt, flooded, island, draw_
     behind a receding meniscus (``layer``) lay are drawn from the cell before them, on every
     face and through the outlet and the side. Each round scales every short cell's outgoing
     fluxes by what it can give, at most 100 rounds a pass. Returns the new qx, qy, q_last,
-    q_side and every cell's net inflow with them [m3/s] (:func:`net_inflow`;
+    q_side and every cell's net inflow with them [m3/s] (:func:`_read`;
     :func:`ehlfoam.thinfilm.pass_kernels.moves`).
 
     The net inflow and which cells are short are read over the grid at the start and after
