@@ -1076,6 +1076,28 @@ def test_parallel_run_matches_serial(small_case, tmp_path):
 @pytest.mark.openfoam
 @pytest.mark.skipif(os.geteuid() != 0 or shutil.which("unshare") is None,
                     reason="parallel runs of the embedded runtime need root and unshare")
+def test_parallel_runs_side_by_side_keep_their_shared_memory_apart(tmp_path):
+    """Two 2-rank runs at once (a batch's jobs with run.n_procs = 2): each run's ranks share
+    memory with their own run only, so both finish with the same answer. Their segments were
+    named after mpirun's pid, 1 in every run's namespace: one run's ranks crashed with a
+    segmentation fault, the other's hung."""
+    spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "end_time": 3e-4, "n_procs": 2}})
+    cases = [tmp_path / name for name in ("a", "b")]
+    for case in cases:
+        write_case(spec, case)
+    procs = [subprocess.Popen([*EHLFOAM, "run", str(case), "--quiet", "--wall-limit", "120"],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+             for case in cases]
+    outs = [p.communicate(timeout=300)[0] for p in procs]
+    ends = [json.loads((case / "metrics.json").read_text()) for case in cases]
+    for m, out in zip(ends, outs):
+        assert (m["status"], m["end_reason"]) == ("finished", "end_time"), out
+    assert ends[0]["oil_volume_m3"] == pytest.approx(ends[1]["oil_volume_m3"], rel=1e-9)
+
+
+@pytest.mark.openfoam
+@pytest.mark.skipif(os.geteuid() != 0 or shutil.which("unshare") is None,
+                    reason="parallel runs of the embedded runtime need root and unshare")
 def test_parallel_restart_decomposes_its_latest_time_only(tmp_path):
     """A reconstructed case (no processor folders: say one run serially before) restarts on
     2 ranks from its latest time: decomposePar takes that time only, not every write, and the

@@ -232,9 +232,12 @@ class FoamRuntime:
         bind-mounted at ``/mnt`` (the mounts vanish with the process) and a PID namespace of
         its own (``unshare --mount --pid --fork --kill-child``): when ``unshare`` dies, however
         it dies, the kernel kills every process of the run, mpirun's daemon and ranks
-        included. Its ``/tmp`` is a private tmpfs (mpirun's session folder, named after its
-        pid, which is 1 in every run, vanishes with it). Needs root. ``case`` may be relative to the process's working folder (e.g.
-        "." in a script).
+        included. Its ``/tmp`` and ``/dev/shm`` are private tmpfs: mpirun's session folder
+        and the ranks' shared-memory segments are named after its pid, which is 1 in every
+        run, so runs side by side would share them (the ranks of one crashed with a
+        segmentation fault, the other's hung) and a killed run's would stay behind. Needs
+        root. ``case`` may be relative to the process's working folder (e.g. "." in a
+        script).
         """
         if n_procs < 2:
             raise FoamConfigError(f"n_procs = {n_procs}: an MPI run needs at least 2 ranks")
@@ -251,9 +254,11 @@ class FoamRuntime:
             "PRTE_ALLOW_RUN_AS_ROOT", "PRTE_ALLOW_RUN_AS_ROOT_CONFIRM"))
         inner = shlex.join([*MPIRUN, "-np", str(n_procs), app, *args,
                             "-parallel"])
+        shm = shlex.quote(str(root / "dev" / "shm"))
         script = (f"mount --bind {shlex.quote(str(case))} {shlex.quote(str(root / 'mnt'))} && "
                   f"mount -t proc proc {shlex.quote(str(root / 'proc'))} && "
                   f"mount -t tmpfs tmpfs {shlex.quote(str(root / 'tmp'))} && "
+                  f"mkdir -p {shm} && mount -t tmpfs tmpfs {shm} && "
                   f"exec chroot {shlex.quote(str(root))} env -i PATH=/usr/bin:/bin HOME=/root "
                   f"WM_PROJECT_DIR=/usr/share/openfoam {allow} "
                   f"sh -c {shlex.quote('cd /mnt && exec ' + inner)}")
