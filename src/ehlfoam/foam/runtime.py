@@ -233,9 +233,10 @@ class FoamRuntime:
         its own (``unshare --mount --pid --fork --kill-child``): when ``unshare`` dies, however
         it dies, the kernel kills every process of the run, mpirun's daemon and ranks
         included. Its ``/tmp`` and ``/dev/shm`` are private tmpfs: mpirun's session folder
-        and the ranks' shared-memory segments are named after its pid, which is 1 in every
-        run, so runs side by side would share them (the ranks of one crashed with a
-        segmentation fault, the other's hung) and a killed run's would stay behind. Needs
+        and the ranks' shared-memory segments are named after its pid or its job id, the
+        same in every run's namespace, so runs side by side would share them (the ranks of
+        one crashed with a segmentation fault, the other's hung) and a killed run's would
+        stay behind. Needs
         root. ``case`` may be relative to the process's working folder (e.g. "." in a
         script).
         """
