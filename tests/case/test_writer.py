@@ -1079,8 +1079,8 @@ def test_parallel_run_matches_serial(small_case, tmp_path):
 def test_parallel_runs_side_by_side_keep_their_shared_memory_apart(tmp_path):
     """Two 2-rank runs at once (a batch's jobs with run.n_procs = 2): each run's ranks share
     memory with their own run only, so both finish with the same answer. Their segments were
-    named after mpirun's pid, 1 in every run's namespace: one run's ranks crashed with a
-    segmentation fault, the other's hung."""
+    kept in the runtime's /dev/shm under a job id the same in every run's namespace: one
+    run's ranks crashed with a segmentation fault, the other's hung."""
     spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "end_time": 3e-4, "n_procs": 2}})
     cases = [tmp_path / name for name in ("a", "b")]
     for case in cases:

@@ -236,9 +236,8 @@ class FoamRuntime:
         and the ranks' shared-memory segments are named after its pid or its job id, the
         same in every run's namespace, so runs side by side would share them (the ranks of
         one crashed with a segmentation fault, the other's hung) and a killed run's would
-        stay behind. Needs
-        root. ``case`` may be relative to the process's working folder (e.g. "." in a
-        script).
+        stay behind. Needs root. ``case`` may be relative to the process's working folder
+        (e.g. "." in a script).
         """
         if n_procs < 2:
             raise FoamConfigError(f"n_procs = {n_procs}: an MPI run needs at least 2 ranks")
