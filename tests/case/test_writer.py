@@ -954,6 +954,35 @@ def test_cli_case_warns_when_thin_wall_cells_stair_step_along_the_ball(tmp_path)
 
 
 @pytest.mark.openfoam
+def test_isoadvector_runs_the_interface_scene_on_interisofoam(tmp_path):
+    """physics.interface_advection = "isoadvector": the case runs interIsoFoam with
+    isoAdvector's controls, to its end, and keeps the oil the compression run of the same
+    case keeps; a scene with phase change refuses it before anything is written."""
+    ends = {}
+    for advection in ("compression", "isoadvector"):
+        spec = make_case_spec({**SMALL, "physics": {"interface_advection": advection},
+                               "run": {**SMALL["run"], "end_time": 3e-4}})
+        case = tmp_path / advection
+        write_case(spec, case)
+        ends[advection] = run_case(case, wall_limit=120)
+        assert (ends[advection]["status"], ends[advection]["end_reason"]) == (
+            "finished", "end_time"), ends[advection]
+    case = tmp_path / "isoadvector"
+    with FoamFile(case / "system" / "controlDict") as f:
+        assert f["application"] == "interIsoFoam"
+    with FoamFile(case / "system" / "fvSolution") as f:
+        alpha = f["solvers"]['"alpha.oil.*"']
+        assert (alpha["isoFaceTol"], alpha["nAlphaBounds"], alpha["clip"]) == (1e-6, 3, True)
+    assert (case / "log.interIsoFoam").stat().st_size > 0
+    iso, mules = ends["isoadvector"], ends["compression"]
+    assert iso["oil_mass_balance_error"] < 1e-3
+    assert iso["oil_volume_m3"] == pytest.approx(mules["oil_volume_m3"], rel=1e-3)
+    with pytest.raises(SpecError, match='interface_advection = "isoadvector" needs scene'):
+        make_case_spec({**SMALL, "scene": "gas-release",
+                        "physics": {"interface_advection": "isoadvector"}})
+
+
+@pytest.mark.openfoam
 def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
     case = _copy(small_case, tmp_path)
     with FoamFile(case / "system" / "controlDict") as f:   # a fixed, absurd time step

@@ -14,6 +14,11 @@ from ehlfoam.spec.case import CaseSpec
 #: molWeight) and specific gas constant [J/(kg K)].
 AIR_MOLAR_MASS = 28.9e-3
 AIR_GAS_CONSTANT = 8.314462618 / AIR_MOLAR_MASS
+#: interIsoFoam's (isoAdvector's) controls, as v1912's tutorials set them: the tolerance on
+#: alpha where a cell is cut by the isosurface, the band of alpha that makes a cell a surface
+#: cell, the bounding passes, the snap to 0 and 1, and clipping to [0, 1]
+ISOADVECTOR_CONTROLS = {"isoFaceTol": 1e-6, "surfCellTol": 1e-6, "nAlphaBounds": 3,
+                        "snapTol": 1e-12, "clip": True}
 
 
 def edit_physics_dicts(spec: CaseSpec, case: Path) -> None:
@@ -29,6 +34,9 @@ def edit_physics_dicts(spec: CaseSpec, case: Path) -> None:
         f["PIMPLE"]["nCorrectors"] = spec.run.pressure_correctors
         if spec.run.alpha_subcycles is not None:
             f["solvers"]['"alpha.oil.*"']["nAlphaSubCycles"] = spec.run.alpha_subcycles
+        if spec.physics.interface_advection == "isoadvector":
+            for key, value in ISOADVECTOR_CONTROLS.items():
+                f["solvers"]['"alpha.oil.*"'][key] = value
     if spec.physics.interface_schemes == "balanced":
         _balance_interface_schemes(case)
     write_decomposition(case, spec.run.n_procs)

@@ -49,6 +49,8 @@ from ehlfoam.spec.thin_film import (THIN_FILM_WRITES_PER_TRANSIT, THREE_D_ONLY, 
 SOLVERS = {"interface": "interFoam", "single-phase": "interFoam",
            "cavitating": "compressibleInterFoam", "gas-release": "interPhaseChangeFoam",
            "thin-film": "thin-film"}
+#: The interface scene's application with ``physics.interface_advection = "isoadvector"``
+ISOADVECTOR_SOLVER = "interIsoFoam"
 
 
 class CaseSpec(BaseModel):
@@ -191,7 +193,10 @@ class CaseSpec(BaseModel):
 
     @property
     def solver(self) -> str:
-        """The OpenFOAM application of the scene."""
+        """The OpenFOAM application of the scene (interIsoFoam for the interface scene with
+        ``physics.interface_advection = "isoadvector"``)."""
+        if self.physics.interface_advection == "isoadvector":
+            return ISOADVECTOR_SOLVER
         return SOLVERS[self.scene]
 
     @property
@@ -253,6 +258,12 @@ def _check_scene_options(spec: CaseSpec) -> None:
             f"invalid case spec: run.air_viscosity_factor = {spec.run.air_viscosity_factor:g} "
             f"does not apply to scene = \"gas-release\", whose air has the oil's kinematic "
             f"viscosity (leave it at {default:g})")
+    advection = spec.physics.interface_advection
+    if advection == "isoadvector" and spec.scene not in ("interface", "thin-film"):
+        raise SpecError(
+            f'invalid case spec: physics.interface_advection = "isoadvector" needs scene = '
+            f'"interface" (here {spec.scene!r}): interIsoFoam has one incompressible oil and '
+            f'air, no phase change (valid otherwise: "compression")')
     rate = spec.physics.gas_dissolution_rate
     if rate > 0 and (spec.scene != "gas-release" or spec.supply.mode != "submerged"):
         raise SpecError(
