@@ -14,9 +14,10 @@ from ehlfoam.spec.case import CaseSpec
 #: molWeight) and specific gas constant [J/(kg K)].
 AIR_MOLAR_MASS = 28.9e-3
 AIR_GAS_CONSTANT = 8.314462618 / AIR_MOLAR_MASS
-#: interIsoFoam's (isoAdvector's) controls, as v1912's tutorials set them: the tolerance on
-#: alpha where a cell is cut by the isosurface, the band of alpha that makes a cell a surface
-#: cell, the bounding passes, the snap to 0 and 1, and clipping to [0, 1]
+#: interIsoFoam's (isoAdvector's) controls, the values of its damBreak tutorial (read in a
+#: later release's copy; v1912 ran with them): the tolerance on alpha where a cell is cut by
+#: the isosurface, the band of alpha that makes a cell a surface cell, the bounding passes,
+#: the snap to 0 and 1, and clipping to [0, 1]
 ISOADVECTOR_CONTROLS = {"isoFaceTol": 1e-6, "surfCellTol": 1e-6, "nAlphaBounds": 3,
                         "snapTol": 1e-12, "clip": True}
 

@@ -50,8 +50,8 @@ THREE_D_ONLY: dict[str, tuple[tuple[str, ...], str]] = {
                "the model's supply covers the whole track and it seeds no gas"),
     "physics": (("oil_density", "air_density", "air_viscosity", "interface_compression",
                  "isotropic_compression", "interface_schemes", "interface_advection",
-                 "wall_slip_length",
-                 "oil_bulk_modulus", "gas_release_rate", "gas_dissolution_rate"),
+                 "wall_slip_length", "oil_bulk_modulus", "gas_release_rate",
+                 "gas_dissolution_rate"),
                 "the gap-averaged model has no inertia, no air flow, no interface numerics "
                 "and no gas-release kinetics"),
     "mesh": (("n_layers", "size_rim", "size_far", "wall_grading", "wall_cell",
