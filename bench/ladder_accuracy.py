@@ -2,8 +2,8 @@
 error of each rung against the finest that comes to rest, against its CPU cost.
 
     python bench/ladder_accuracy.py [--rungs R ...] [--points N ...] [--cap-s S]
-        [--procs N] [--jobs N] [--set KEY=VALUE ...] [--charts DIR] [--work DIR]
-        [--out FILE.json]
+        [--procs N] [--jobs N] [--set KEY=VALUE ...] [--set-3d KEY=VALUE ...]
+        [--charts DIR] [--work DIR] [--out FILE.json]
     python bench/ladder_accuracy.py --quick
 
 The reference points (HVI60, 20 N, gas below 90 kPa, layers on disc and ball over a +-0.3 mm
@@ -13,7 +13,8 @@ rung (``ehlfoam case --rung`` + ``ehlfoam run``; one after the other on one core
 ``--jobs`` cases side by side, the 3D ones on ``--procs`` MPI ranks each): the thin-film
 levels to rest (150 transits at most); the 3D rungs in the gas-release scene (the thin-film
 outlet's counterpart), started from the point's thin-film balance, capped at ``--cap-s`` of
-wall time and 6 transits. The reference of a point is the finest rung (the last of
+wall time and 6 transits (``--set-3d`` sets a spec option on the 3D rungs alone, e.g.
+``scene=interface``). The reference of a point is the finest rung (the last of
 ``--rungs``) that came to rest (``steady``). Per metric (state, inlet meniscus, flooded
 width, bubble or wake length, oil held) each rung's error against it: the state right or
 wrong, the others relative, each metric the run's mean over its last transit (a single
@@ -65,19 +66,22 @@ METRICS = {"inlet": "inlet_meniscus_distance_over_a", "width": "flooded_width_ov
 
 
 def point_spec(point: tuple, rung: str, base: dict, cap_s: float, procs: int = 1,
-               overrides: dict | None = None) -> CaseSpec:
+               overrides: dict | None = None, overrides_3d: dict | None = None) -> CaseSpec:
     """The case spec of a reference point on a rung (a 3D rung on ``procs`` MPI ranks),
-    with ``overrides`` (dotted spec keys, as ``ehlfoam case --set``)."""
+    with ``overrides`` (dotted spec keys, as ``ehlfoam case --set``) and, on a 3D rung,
+    ``overrides_3d`` after them."""
     _, temperature, speed, layer = point
     data = {**base, "contact": {**base["contact"], "speed": speed,
                                 "temperature": temperature},
             "supply": {**base["supply"], "disc_layer": layer, "ball_layer": layer}}
+    overrides = dict(overrides or {})
     if rung.startswith("thin-film"):
         data["run"] = {"transits_max": 150.0}
     else:
         data.update(scene="gas-release", run={"start": "thin-film", "transits_max": 6.0,
                                               "wall_limit": cap_s, "n_procs": procs})
-    return make_case_spec(data, rung=rung, **(overrides or {}))
+        overrides.update(overrides_3d or {})
+    return make_case_spec(data, rung=rung, **overrides)
 
 
 def run_point(label: str, rung: str, spec: CaseSpec, case: Path) -> dict:
@@ -216,6 +220,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="cases run side by side (1-64, default 1)")
     ap.add_argument("--set", action="append", default=[], type=spec_option,
                     metavar="KEY=VALUE", help="a spec option on every case (repeatable)")
+    ap.add_argument("--set-3d", action="append", default=[], type=spec_option,
+                    metavar="KEY=VALUE", help="a spec option on the 3D rungs' cases, after "
+                    "--set's (repeatable)")
     ap.add_argument("--charts", type=Path, default=None, metavar="DIR",
                     help="draw one chart per metric into DIR")
     add_output_options(ap, work=True)
@@ -226,7 +233,7 @@ def main(argv: list[str] | None = None) -> int:
         rungs, points = ["thin-film-coarse", "thin-film-medium"], [POINTS[0], POINTS[2]]
     try:                                            # every spec checked before any run
         specs = [(point[0], rung, point_spec(point, rung, base, args.cap_s, args.procs,
-                                             dict(args.set)))
+                                             dict(args.set), dict(args.set_3d)))
                  for point in points for rung in rungs]
     except SpecError as err:
         ap.error(str(err))
@@ -254,7 +261,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"chart {path}")
     write_out(args.out, {"rungs": rungs, "points": [p[0] for p in points],
                          "cap_s": args.cap_s, "procs": args.procs, "jobs": args.jobs,
-                         "set": dict(args.set),
+                         "set": dict(args.set), "set_3d": dict(args.set_3d),
                          "rows": rows, "summary": table})
     return 0
 

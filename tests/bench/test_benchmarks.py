@@ -129,10 +129,12 @@ def test_ladder_accuracy_measures_each_rung_against_the_finest_at_rest(tmp_path)
     """Two points on the two cheapest thin-film levels: the finer one at rest is each
     point's reference (its own errors zero), the coarser one's errors are its metrics'
     distance from it, and the summary has a row per rung with its cost. Two cases at a
-    time (``--jobs 2``): the rows still in point, rung order."""
-    stdout, rec = run_bench("ladder_accuracy", tmp_path, "--jobs", "2")
+    time (``--jobs 2``): the rows still in point, rung order. A 3D-only option given with
+    ``--set-3d`` leaves the thin-film rungs alone (``--set`` would have them refuse it)."""
+    stdout, rec = run_bench("ladder_accuracy", tmp_path, "--jobs", "2",
+                            "--set-3d", "physics.interface_advection=isoadvector")
     rows = rec["rows"]
-    assert rec["jobs"] == 2
+    assert rec["jobs"] == 2 and rec["set_3d"] == {"physics.interface_advection": "isoadvector"}
     assert [(r["point"], r["rung"]) for r in rows] == [
         (p, r) for p in rec["points"] for r in ("thin-film-coarse", "thin-film-medium")]
     for r in rows:
@@ -153,6 +155,20 @@ def test_ladder_accuracy_refuses_a_bad_spec_option_before_any_run(tmp_path):
                            "thin_film.courant=7", "--work", str(tmp_path / "w")],
                           cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and "thin_film.courant = 7" in proc.stderr, proc.stderr
+    assert not (tmp_path / "w").exists()
+
+
+@pytest.mark.parametrize("option", ["--set", "--set-3d"])
+def test_ladder_accuracy_refuses_a_bad_3d_option_before_any_run(tmp_path, option):
+    """``--set`` reaches the thin-film rung too, which refuses a 3D-only key; a bad value
+    under ``--set-3d`` is refused on the 3D rung. Both before any run."""
+    value = "isoadvector" if option == "--set" else "vof"
+    proc = subprocess.run([sys.executable, "bench/ladder_accuracy.py", "--rungs",
+                           "thin-film-medium", "coarse", "--points", "0", option,
+                           f"physics.interface_advection={value}", "--work",
+                           str(tmp_path / "w")],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "interface_advection" in proc.stderr, proc.stderr
     assert not (tmp_path / "w").exists()
 
 
