@@ -992,9 +992,49 @@ def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
     m = run_case(case, wall_limit=120)
     assert m["status"] == "failed" and m["end_reason"] == "diverged", m
     assert (case / "log.interFoam").stat().st_size > 0
-    assert m["log_tail"]
+    assert m["log_tail"] and m["reason"].startswith("interFoam failed after"), m["reason"]
     saved = json.loads((case / "metrics.json").read_text())
     assert saved["status"] == "failed"
+
+
+def _solver_of(case: Path, timeout: float = 120.0) -> int:
+    """The pid of the solver running in ``case`` (the runtime's loader, its working folder
+    the case), once the case has a write past 0."""
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout:
+        for pid in (d for d in os.listdir("/proc") if d.isdigit()):
+            try:
+                cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
+                here = os.readlink(f"/proc/{pid}/cwd") == str(case)
+            except OSError:
+                continue
+            if here and b"interFoam" in cmd and len(case_fields.time_folders(case)) > 1:
+                return int(pid)
+        time.sleep(0.05)
+    raise AssertionError(f"no solver ran in {case}")
+
+
+@pytest.mark.openfoam
+@pytest.mark.parametrize("sig, end, words", [
+    (signal.SIGSEGV, "crashed", "signal 11 (Segmentation fault)"),
+    (signal.SIGFPE, "diverged", "signal 8 (Floating point exception), a floating-point trap")])
+def test_a_solver_killed_by_a_signal_says_which(tmp_path, sig, end, words):
+    """A solver that dies on a segmentation fault after its first steps (a library, memory,
+    two runs' MPI segments) crashed; on a floating-point trap its numerics diverged. Both
+    fail, keep their logs, and ``reason`` names the signal (read from the log)."""
+    spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "end_time": 5e-2}})
+    case = tmp_path / "case"
+    write_case(spec, case)
+    proc = subprocess.Popen([*EHLFOAM, "run", str(case), "--quiet", "--wall-limit", "120"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        os.kill(_solver_of(case), sig)
+    finally:
+        out = proc.communicate(timeout=180)[0]
+    m = json.loads((case / "metrics.json").read_text())
+    assert (m["status"], m["end_reason"]) == ("failed", end), out
+    assert words in m["reason"] and m["time_steps"] > 0, m["reason"]
+    assert (case / "log.interFoam").stat().st_size > 0
 
 
 @pytest.mark.openfoam

@@ -25,7 +25,7 @@ LOG_TAIL_LINES = 20
 @dataclass(frozen=True)
 class RunEnd:
     """How the solver's run ended: ``reason`` (steady, end_time, wall_limit, diverged,
-    interrupted), whether it ``failed``, its ``exit_code``, the ``time_steps`` it took, its
+    crashed, interrupted), whether it ``failed``, its ``exit_code``, the ``time_steps`` it took, its
     last time step [s], its wall-clock time [s] and the steady-state test that stopped it."""
 
     reason: str

@@ -6,7 +6,9 @@ The end reasons are listed in :mod:`ehlfoam.run.monitor`."""
 
 from __future__ import annotations
 
+import re
 import shutil
+import signal
 from pathlib import Path
 
 from ehlfoam.case.geometry import CaseGeometry
@@ -18,11 +20,15 @@ from ehlfoam.run.outflow import write_outflow
 from ehlfoam.run.start import START_FAILED, failure_from_log
 from ehlfoam.spec.case import CaseSpec
 
-__all__ = ["CASE_REMOVED", "MONITOR_ERROR", "end_reason", "one_line", "removed_record",
-           "trim_past_stop", "write_end"]
+__all__ = ["CASE_REMOVED", "CRASHED", "MONITOR_ERROR", "end_reason", "one_line",
+           "removed_record", "trim_past_stop", "write_end"]
 
 CASE_REMOVED = "case_removed"
+CRASHED = "crashed"
 MONITOR_ERROR = "monitor_error"
+#: The signal the solver's log names: UCX's handler ("Caught signal 11 (Segmentation fault:
+#: ...") in every solver of the runtime, mpirun ("exited on signal 11 (Segmentation fault)").
+_SIGNAL_LINE = re.compile(r"(?:Caught|exited on) signal (\d+) \(([^:)]*)")
 
 
 def one_line(err: BaseException) -> str:
@@ -63,7 +69,8 @@ def end_reason(reason: str | None, detail: str | None, *, exit_code: int | None,
     """The run's end reason, whether it failed, and the words that say why (``detail``
     unless the end is found only now). ``reason``: the one the watch found, or None: then
     the solver's ``exit_code`` says it (0: ``end_time``; no time step logged:
-    ``start_failed``, with the log's words; otherwise ``diverged``)."""
+    ``start_failed``, with the log's words; killed by a signal other than a floating-point
+    trap: ``crashed``, the signal named; otherwise ``diverged``, with the log's words)."""
     if reason is None:
         if exit_code == 0:
             reason = "end_time"
@@ -72,18 +79,64 @@ def end_reason(reason: str | None, detail: str | None, *, exit_code: int | None,
             detail = (f"{geom.solver} stopped before its first time step (exit code "
                       f"{exit_code}): {_log_reason(case, geom)}")
         else:
-            reason = "diverged"
-    failed = reason in ("diverged", START_FAILED, MONITOR_ERROR) or (
+            sig = _signal(exit_code, case, geom)
+            after = f"after {logged_steps} time steps"
+            if sig is not None and sig[0] != signal.SIGFPE:
+                reason = CRASHED
+                detail = (f"{geom.solver} was killed by signal {sig[0]} ({sig[1]}) {after}: "
+                          "a crash (memory, MPI, a library), not a floating-point trap of "
+                          "the numerics; the log has its backtrace")
+            else:
+                reason = "diverged"
+                how = (f"signal {sig[0]} ({sig[1]}), a floating-point trap" if sig else
+                       _fatal_error(case, geom) or f"exit code {exit_code}")
+                detail = f"{geom.solver} failed {after}: {how}"
+    failed = reason in ("diverged", CRASHED, START_FAILED, MONITOR_ERROR) or (
         exit_code not in (0, None, -9) and reason != "interrupted")
     return reason, failed, detail
 
 
-def _log_reason(case: Path, geom: CaseGeometry) -> str:
+def _log_text(case: Path, geom: CaseGeometry, tail: int | None = 65536) -> str:
+    """The solver log's last ``tail`` bytes (None: all of it), '' without a log; a signal's
+    or a fatal error's words are at its end, and a long run's log is hundreds of MB."""
     try:
-        text = (case / geom.log_name).read_text(errors="replace")
+        with open(case / geom.log_name, "rb") as fh:
+            if tail is not None:
+                fh.seek(0, 2)
+                fh.seek(max(fh.tell() - tail, 0))
+            return fh.read().decode(errors="replace")
     except OSError:
+        return ""
+
+
+def _fatal_error(case: Path, geom: CaseGeometry) -> str | None:
+    """The solver log's ``FOAM FATAL ERROR`` in one line, None without one."""
+    text = _log_text(case, geom)
+    return failure_from_log(text) if "FOAM FATAL" in text else None
+
+
+def _signal(exit_code: int | None, case: Path, geom: CaseGeometry) -> tuple[int, str] | None:
+    """The signal (number, name) that killed the solver: read from its log, else from its
+    exit code (negative: the signal; above 128: 128 + the signal, as a shell or mpirun passes
+    it on). None for an error exit."""
+    found = _SIGNAL_LINE.findall(_log_text(case, geom))
+    if found:
+        number, name = int(found[0][0]), found[0][1].strip()
+    elif exit_code is not None and (exit_code < 0 or 128 < exit_code < 160):
+        number = -exit_code if exit_code < 0 else exit_code - 128
+        try:
+            name = signal.strsignal(number) or f"signal {number}"
+        except ValueError:
+            name = f"signal {number}"
+    else:
+        return None
+    return number, name
+
+
+def _log_reason(case: Path, geom: CaseGeometry) -> str:
+    if not (case / geom.log_name).is_file():
         return "no solver log"
-    return failure_from_log(text) or "an empty solver log"
+    return failure_from_log(_log_text(case, geom, tail=None)) or "an empty solver log"
 
 
 def write_end(case: Path, spec: CaseSpec, geom: CaseGeometry,

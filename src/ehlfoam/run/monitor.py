@@ -16,9 +16,11 @@ solver at once (``stopAt writeNow``). End reasons:
   least-squares trend over the last transit is within the tolerance too;
 - ``end_time``: the simulated time limit was reached first;
 - ``wall_limit``: the wall-clock limit was reached first;
-- ``diverged``: the solver failed after its first time step (non-zero exit, e.g. a
-  floating-point trap) or its time step collapsed; the logs stay and metrics.json says
-  ``status: failed``;
+- ``diverged``: the solver failed after its first time step (a floating-point trap, a fatal
+  error) or its time step collapsed; the logs stay and metrics.json says ``status: failed``;
+- ``crashed``: the solver was killed after its first time step by another signal (a
+  segmentation fault, a bus error, an out-of-memory kill): not the numerics; ``reason``
+  names the signal, the logs stay, ``status: failed``;
 - ``start_failed``: the run failed before its first time step (decomposition, OpenFOAM
   refusing the case's path, a solver that cannot start); ``reason`` has the log's words
   (:mod:`ehlfoam.run.start`);
