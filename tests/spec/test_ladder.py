@@ -85,3 +85,16 @@ def test_the_thin_film_counterpart_keeps_the_point_and_drops_the_3d_keys():
     assert tf.contact == spec.contact and tf.supply == spec.supply and tf.domain == spec.domain
     assert tf.physics.wall_slip_length == 0.0 and tf.physics.contact_angle == 15.0
     assert tf.run.transits_max == 150.0 and tf.run.wall_limit == spec.run.wall_limit
+
+
+def test_the_ladder_reads_the_case_specs_scenes_and_default():
+    """The ladder fills a rung in before the case spec validates, so it reads the scene
+    itself: its scenes are the spec's, the first its default."""
+    from typing import get_args
+
+    from ehlfoam.spec import ladder
+    from ehlfoam.spec.case import CaseSpec
+
+    field = CaseSpec.model_fields["scene"]
+    assert set(ladder._SCENES) == set(get_args(field.annotation))
+    assert ladder._scene({}) == field.default == "interface"

@@ -103,7 +103,7 @@ def expand_rung(data: dict[str, Any]) -> dict[str, Any]:
     mesh = _table(data, "mesh")
     rung = data.get("rung")
     if rung is None:
-        scene = data.get("scene", "interface")
+        scene = _scene(data)
         level = mesh.get("resolution", "medium")
         if scene in _SCENES and level in LEVELS:   # anything else: the fields' own errors
             data = {**data, "rung": rung_of(scene, level)}
@@ -115,7 +115,7 @@ def expand_rung(data: dict[str, Any]) -> dict[str, Any]:
     if given is not None and given != level:
         raise ValueError(f"rung = {rung!r} and mesh.resolution = {given!r} "
                         f"disagree: the rung sets the level ({level!r}); set one of them")
-    scene = data.get("scene", "interface")
+    scene = _scene(data)
     if family != "thin-film" and scene == "thin-film":
         raise ValueError(f"rung = {rung!r} is a 3D rung and scene = "
                         f"\"thin-film\" is not a 3D scene: set scene to \"interface\", "
@@ -132,12 +132,17 @@ def expand_rung(data: dict[str, Any]) -> dict[str, Any]:
 _SCENES = ("interface", "single-phase", "cavitating", "gas-release", "thin-film")
 
 
+def _scene(data: dict[str, Any]) -> Any:
+    """The data's scene, or the case spec's default (``CaseSpec.scene``: "interface")."""
+    return data.get("scene", _SCENES[0])
+
+
 def _resolved_family(data: dict[str, Any]) -> dict[str, Any]:
     """:data:`RESOLVED_FAMILY` with the side band's edge at the track's and the wall's angle
     at the rolling speed (left out where the contact or the supply is not valid yet: the
     fields' own errors say why)."""
     family = {k: dict(v) for k, v in RESOLVED_FAMILY.items()}
-    for table, values in RESOLVED_SCENE.get(data.get("scene", "interface"), {}).items():
+    for table, values in RESOLVED_SCENE.get(_scene(data), {}).items():
         family[table].update(values)
     try:
         from ehlfoam.contact.spec import PrecalcSpec
