@@ -3,7 +3,7 @@ error of each rung against the finest that comes to rest, against its CPU cost.
 
     python bench/ladder_accuracy.py [--rungs R ...] [--points N ...] [--cap-s S]
         [--procs N] [--jobs N] [--set KEY=VALUE ...] [--set-3d KEY=VALUE ...]
-        [--charts DIR] [--work DIR] [--out FILE.json]
+        [--join FILE.json ...] [--charts DIR] [--work DIR] [--out FILE.json]
     python bench/ladder_accuracy.py --quick
 
 The reference points (HVI60, 20 N, gas below 90 kPa, layers on disc and ball over a +-0.3 mm
@@ -23,13 +23,16 @@ Cost: the CPU time of the run (the process's own, the thin-film start included, 
 OpenFOAM solver's on every rank), the EHL precalc excluded (solved first, cached). Prints a
 row per point and rung and a summary per rung (error, median CPU, CPU against the
 reference's); ``--charts DIR`` draws one chart per metric, error against CPU (log axis), a
-marker per rung. ``--quick``: two points on the two cheapest thin-film levels
+marker per rung. ``--join`` adds the rows of earlier runs (their ``--out``) at the points
+run here, for a rung dear enough to run once (a joined rung not run here counts as finer than
+those that are). ``--quick``: two points on the two cheapest thin-film levels
 over a small domain (seconds).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import statistics
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -133,6 +136,23 @@ def run_all(specs: list[tuple], jobs: int, work: Path) -> list[dict]:
     return rows
 
 
+def joined_rows(files: list[Path], labels: list[str], rungs: list[str]) -> list[dict]:
+    """The rows of earlier runs' ``--out`` files at the points ``labels`` on rungs not in
+    ``rungs`` (the runs here win), each marked ``joined``. Raises ValueError naming a file
+    that cannot be read or has no rows."""
+    out = []
+    for path in files:
+        try:
+            rows = json.loads(Path(path).read_text())["rows"]
+        except (OSError, ValueError, KeyError, TypeError) as err:
+            raise ValueError(f"--join {path}: not a ladder_accuracy --out file ({err})")
+        if not rows:
+            raise ValueError(f"--join {path}: it has no rows")
+        out += [r | {"joined": str(path)} for r in rows
+                if r["point"] in labels and r["rung"] not in rungs]
+    return out
+
+
 def errors(rows: list[dict], rungs: list[str]) -> dict[str, dict]:
     """Each point's reference row (the finest rung at rest) and every row's errors against
     it, in place: ``state_ok`` and ``err_<metric>`` (relative; the bubble's where the
@@ -223,6 +243,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--set-3d", action="append", default=[], type=spec_option,
                     metavar="KEY=VALUE", help="a spec option on the 3D rungs' cases, after "
                     "--set's (repeatable)")
+    ap.add_argument("--join", nargs="+", type=Path, default=[], metavar="FILE.json",
+                    help="rows of earlier runs (their --out) at the points run here")
     ap.add_argument("--charts", type=Path, default=None, metavar="DIR",
                     help="draw one chart per metric into DIR")
     add_output_options(ap, work=True)
@@ -235,10 +257,14 @@ def main(argv: list[str] | None = None) -> int:
         specs = [(point[0], rung, point_spec(point, rung, base, args.cap_s, args.procs,
                                              dict(args.set), dict(args.set_3d)))
                  for point in points for rung in rungs]
-    except SpecError as err:
+        joined = joined_rows(args.join, [p[0] for p in points], rungs)
+    except (SpecError, ValueError) as err:
         ap.error(str(err))
     with work_folder(args.work) as work:
         rows = run_all(specs, args.jobs, work)
+    rungs = rungs + [r for r in dict.fromkeys(j["rung"] for j in joined)]
+    order = [p[0] for p in points]
+    rows = sorted(rows + joined, key=lambda r: (order.index(r["point"]), rungs.index(r["rung"])))
     errors(rows, rungs)
     print_table(rows, [
         ("point", "point", ""), ("rung", "rung", ""), ("end_reason", "end", ""),
@@ -262,6 +288,7 @@ def main(argv: list[str] | None = None) -> int:
     write_out(args.out, {"rungs": rungs, "points": [p[0] for p in points],
                          "cap_s": args.cap_s, "procs": args.procs, "jobs": args.jobs,
                          "set": dict(args.set), "set_3d": dict(args.set_3d),
+                         "join": [str(f) for f in args.join],
                          "rows": rows, "summary": table})
     return 0
 

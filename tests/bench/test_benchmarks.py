@@ -150,6 +150,36 @@ def test_ladder_accuracy_measures_each_rung_against_the_finest_at_rest(tmp_path)
     assert len(table_rows(stdout, "rung  points")) == 2
 
 
+def test_ladder_accuracy_joins_the_rows_of_an_earlier_run(tmp_path):
+    """An earlier run's rows on a rung not run here (a dear reference run once) join this
+    run's before the errors: the joined rung counts as the finest, so it is the reference
+    where it is at rest. Joined: the first run's medium rows relabelled as a finer rung, so
+    the medium level's errors against them are nil (the thin-film runs repeat byte for
+    byte) and the coarse level's are the first run's."""
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    _, first = run_bench("ladder_accuracy", tmp_path / "a")
+    earlier = [r | {"rung": "thin-film-fine"} for r in first["rows"]
+               if r["rung"] == "thin-film-medium"]
+    join = tmp_path / "earlier.json"
+    join.write_text(json.dumps({"rows": earlier}))
+    _, rec = run_bench("ladder_accuracy", tmp_path / "b", "--join", str(join))
+    assert rec["rungs"] == ["thin-film-coarse", "thin-film-medium", "thin-film-fine"]
+    rows = {(r["point"], r["rung"]): r for r in rec["rows"]}
+    assert len(rows) == 6 and all(r["reference"] == "thin-film-fine" for r in rows.values())
+    before = {(r["point"], r["rung"]): r for r in first["rows"]}
+    for point in rec["points"]:
+        assert rows[point, "thin-film-fine"]["joined"] == str(join)
+        assert rows[point, "thin-film-medium"]["err_width"] == 0
+        assert rows[point, "thin-film-coarse"]["err_width"] == pytest.approx(
+            before[point, "thin-film-coarse"]["err_width"], rel=1e-12)
+    proc = subprocess.run([sys.executable, "bench/ladder_accuracy.py", "--quick", "--join",
+                           str(tmp_path / "none.json"), "--work", str(tmp_path / "w")],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "--join" in proc.stderr and "none.json" in proc.stderr
+    assert not (tmp_path / "w").exists()
+
+
 def test_ladder_accuracy_refuses_a_bad_spec_option_before_any_run(tmp_path):
     proc = subprocess.run([sys.executable, "bench/ladder_accuracy.py", "--quick", "--set",
                            "thin_film.courant=7", "--work", str(tmp_path / "w")],
