@@ -3,7 +3,7 @@ error of each rung against the finest that comes to rest, against its CPU cost.
 
     python bench/ladder_accuracy.py [--rungs R ...] [--points N ...] [--cap-s S]
         [--procs N] [--jobs N] [--set KEY=VALUE ...] [--set-3d KEY=VALUE ...]
-        [--join FILE.json ...] [--charts DIR] [--work DIR] [--out FILE.json]
+        [--join FILE.json ...] [--reference RUNG] [--charts DIR] [--work DIR] [--out FILE.json]
     python bench/ladder_accuracy.py --quick
 
 The reference points (HVI60, 20 N, gas below 90 kPa, layers on disc and ball over a +-0.3 mm
@@ -22,7 +22,8 @@ write carries the menisci's jitter; the last write's where the state changed wit
 Cost: the CPU time of the run (the process's own, the thin-film start included, plus the
 OpenFOAM solver's on every rank), the EHL precalc excluded (solved first, cached). Prints a
 row per point and rung and a summary per rung (error, median CPU, CPU against the
-reference's); ``--charts DIR`` draws one chart per metric, error against CPU (log axis), a
+reference's); ``--reference RUNG`` makes that rung's row each point's reference, at rest or
+not (a 3D run capped before its rest; the tables say which rows rested); ``--charts DIR`` draws one chart per metric, error against CPU (log axis), a
 marker per rung. ``--join`` adds the rows of earlier runs (their ``--out``) at the points
 run here, for a rung dear enough to run once (a joined rung not run here counts as finer than
 those that are). ``--quick``: two points on the two cheapest thin-film levels
@@ -153,13 +154,16 @@ def joined_rows(files: list[Path], labels: list[str], rungs: list[str]) -> list[
     return out
 
 
-def errors(rows: list[dict], rungs: list[str]) -> dict[str, dict]:
-    """Each point's reference row (the finest rung at rest) and every row's errors against
-    it, in place: ``state_ok`` and ``err_<metric>`` (relative; the bubble's where the
-    reference has one, else the wake's)."""
+def errors(rows: list[dict], rungs: list[str],
+           reference: str | None = None) -> dict[str, dict]:
+    """Each point's reference row (the finest rung at rest, or the ``reference`` rung's row
+    at rest or not) and every row's errors against it, in place: ``state_ok`` and
+    ``err_<metric>`` (relative; the bubble's where the reference has one, else the
+    wake's)."""
     refs = {}
     for point in dict.fromkeys(r["point"] for r in rows):
-        at_rest = [r for r in rows if r["point"] == point and r["steady"]]
+        at_rest = [r for r in rows if r["point"] == point and (
+            r["rung"] == reference if reference else r["steady"])]
         if not at_rest:
             continue
         ref = max(at_rest, key=lambda r: rungs.index(r["rung"]))
@@ -245,6 +249,9 @@ def main(argv: list[str] | None = None) -> int:
                     "--set's (repeatable)")
     ap.add_argument("--join", nargs="+", type=Path, default=[], metavar="FILE.json",
                     help="rows of earlier runs (their --out) at the points run here")
+    ap.add_argument("--reference", default=None, metavar="RUNG",
+                    help="the rung whose rows are the references, at rest or not "
+                    "(default: the finest rung at rest at each point)")
     ap.add_argument("--charts", type=Path, default=None, metavar="DIR",
                     help="draw one chart per metric into DIR")
     add_output_options(ap, work=True)
@@ -260,15 +267,20 @@ def main(argv: list[str] | None = None) -> int:
         joined = joined_rows(args.join, [p[0] for p in points], rungs)
     except (SpecError, ValueError) as err:
         ap.error(str(err))
+    known = rungs + [j["rung"] for j in joined]
+    if args.reference is not None and args.reference not in known:
+        ap.error(f"--reference {args.reference}: not a rung run or joined here "
+                 f"({', '.join(dict.fromkeys(known))})")
     with work_folder(args.work) as work:
         rows = run_all(specs, args.jobs, work)
     rungs = rungs + [r for r in dict.fromkeys(j["rung"] for j in joined)]
     order = [p[0] for p in points]
     rows = sorted(rows + joined, key=lambda r: (order.index(r["point"]), rungs.index(r["rung"])))
-    errors(rows, rungs)
+    errors(rows, rungs, args.reference)
     print_table(rows, [
         ("point", "point", ""), ("rung", "rung", ""), ("end_reason", "end", ""),
-        ("state", "state", ""), ("inlet", "inlet [a]", ".2f"), ("width", "width [a]", ".2f"),
+        ("state", "state", ""), ("steady", "at rest", ""), ("inlet", "inlet [a]", ".2f"),
+        ("width", "width [a]", ".2f"),
         ("bubble", "bubble [a]", ".2f"), ("wake", "wake [a]", ".2f"),
         ("oil", "oil [m3]", ".3g"), ("cpu_s", "CPU [s]", ".1f"), ("reference", "ref", ""),
         ("err_inlet", "e inlet", ".3f"), ("err_width", "e width", ".3f"),
@@ -288,7 +300,7 @@ def main(argv: list[str] | None = None) -> int:
     write_out(args.out, {"rungs": rungs, "points": [p[0] for p in points],
                          "cap_s": args.cap_s, "procs": args.procs, "jobs": args.jobs,
                          "set": dict(args.set), "set_3d": dict(args.set_3d),
-                         "join": [str(f) for f in args.join],
+                         "join": [str(f) for f in args.join], "reference": args.reference,
                          "rows": rows, "summary": table})
     return 0
 

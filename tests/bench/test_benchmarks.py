@@ -150,7 +150,7 @@ def test_ladder_accuracy_measures_each_rung_against_the_finest_at_rest(tmp_path)
     assert len(table_rows(stdout, "rung  points")) == 2
 
 
-def test_ladder_accuracy_joins_the_rows_of_an_earlier_run(tmp_path):
+def test_ladder_accuracy_joins_earlier_rows_and_takes_a_named_reference(tmp_path):
     """An earlier run's rows on a rung not run here (a dear reference run once) join this
     run's before the errors: the joined rung counts as the finest, so it is the reference
     where it is at rest. Joined: the first run's medium rows relabelled as a finer rung, so
@@ -173,11 +173,24 @@ def test_ladder_accuracy_joins_the_rows_of_an_earlier_run(tmp_path):
         assert rows[point, "thin-film-medium"]["err_width"] == 0
         assert rows[point, "thin-film-coarse"]["err_width"] == pytest.approx(
             before[point, "thin-film-coarse"]["err_width"], rel=1e-12)
-    proc = subprocess.run([sys.executable, "bench/ladder_accuracy.py", "--quick", "--join",
-                           str(tmp_path / "none.json"), "--work", str(tmp_path / "w")],
-                          cwd=ROOT, capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 2 and "--join" in proc.stderr and "none.json" in proc.stderr
-    assert not (tmp_path / "w").exists()
+    # --reference: that rung's rows are the references, at rest or not
+    (tmp_path / "c").mkdir()
+    _, rec = run_bench("ladder_accuracy", tmp_path / "c", "--join", str(join),
+                       "--reference", "thin-film-coarse")
+    assert rec["reference"] == "thin-film-coarse"
+    rows = {(r["point"], r["rung"]): r for r in rec["rows"]}
+    for point in rec["points"]:
+        coarse, medium = rows[point, "thin-film-coarse"], rows[point, "thin-film-medium"]
+        assert medium["reference"] == "thin-film-coarse" and coarse["err_width"] == 0
+        assert medium["err_width"] == pytest.approx(
+            abs(medium["width"] - coarse["width"]) / coarse["width"])
+    for bad, words in ((["--join", str(tmp_path / "none.json")], "none.json"),
+                       (["--reference", "fine"], "--reference fine")):
+        proc = subprocess.run([sys.executable, "bench/ladder_accuracy.py", "--quick", *bad,
+                               "--work", str(tmp_path / "w")],
+                              cwd=ROOT, capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2 and words in proc.stderr, proc.stderr
+        assert not (tmp_path / "w").exists()
 
 
 def test_ladder_accuracy_refuses_a_bad_spec_option_before_any_run(tmp_path):
