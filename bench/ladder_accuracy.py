@@ -22,12 +22,12 @@ write carries the menisci's jitter; the last write's where the state changed wit
 Cost: the CPU time of the run (the process's own, the thin-film start included, plus the
 OpenFOAM solver's on every rank), the EHL precalc excluded (solved first, cached). Prints a
 row per point and rung and a summary per rung (error, median CPU, CPU against the
-reference's); ``--reference RUNG`` makes that rung's row each point's reference, at rest or
-not (a 3D run capped before its rest; the tables say which rows rested); ``--charts DIR`` draws one chart per metric, error against CPU (log axis), a
+reference's); ``--charts DIR`` draws one chart per metric, error against CPU (log axis), a
 marker per rung. ``--join`` adds the rows of earlier runs (their ``--out``) at the points
 run here, for a rung dear enough to run once (a joined rung not run here counts as finer than
-those that are). ``--quick``: two points on the two cheapest thin-film levels
-over a small domain (seconds).
+those that are); ``--reference RUNG`` makes that rung's row each point's reference, at rest
+or not (a 3D run capped before its rest; the row table says which rows rested). ``--quick``:
+two points on the two cheapest thin-film levels over a small domain (seconds).
 """
 
 from __future__ import annotations

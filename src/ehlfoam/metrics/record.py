@@ -74,8 +74,9 @@ class MetricsRecord(BaseModel):
     end_reason: str | None = _text(
         "Why the run ended: steady, end_time, wall_limit, diverged (the solver failed after "
         "its first time step: a floating-point trap, a fatal error), crashed (killed by "
-        "another signal after it: a segmentation fault, an out-of-memory kill), start_failed (before it: decomposition, a path OpenFOAM "
-        "refuses, a solver that cannot start; reason has the log's words), case_removed (the "
+        "another signal after it: a segmentation fault, an out-of-memory kill), "
+        "start_failed (before it: decomposition, a path OpenFOAM refuses, a solver that "
+        "cannot start; reason has the log's words), case_removed (the "
         "case folder was removed mid-run), monitor_error, interrupted (Ctrl-C, SIGTERM), "
         "monitor_killed (status interrupted: metrics.json was left running by a killed run, "
         "its run lock free); a batch adds build_error, ramp_start_error, run_error, "
