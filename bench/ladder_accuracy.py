@@ -146,7 +146,7 @@ def joined_rows(files: list[Path], labels: list[str], rungs: list[str]) -> list[
         try:
             rows = json.loads(Path(path).read_text())["rows"]
         except (OSError, ValueError, KeyError, TypeError) as err:
-            raise ValueError(f"--join {path}: not a ladder_accuracy --out file ({err})")
+            raise ValueError(f"--join {path}: not a ladder_accuracy --out file ({err})") from err
         if not rows:
             raise ValueError(f"--join {path}: it has no rows")
         out += [r | {"joined": str(path)} for r in rows
@@ -162,11 +162,11 @@ def errors(rows: list[dict], rungs: list[str],
     wake's)."""
     refs = {}
     for point in dict.fromkeys(r["point"] for r in rows):
-        at_rest = [r for r in rows if r["point"] == point and (
+        candidates = [r for r in rows if r["point"] == point and (
             r["rung"] == reference if reference else r["steady"])]
-        if not at_rest:
+        if not candidates:
             continue
-        ref = max(at_rest, key=lambda r: rungs.index(r["rung"]))
+        ref = max(candidates, key=lambda r: rungs.index(r["rung"]))
         refs[point] = ref
         for r in (r for r in rows if r["point"] == point):
             r["reference"] = ref["rung"]
@@ -273,7 +273,7 @@ def main(argv: list[str] | None = None) -> int:
                  f"({', '.join(dict.fromkeys(known))})")
     with work_folder(args.work) as work:
         rows = run_all(specs, args.jobs, work)
-    rungs = rungs + [r for r in dict.fromkeys(j["rung"] for j in joined)]
+    rungs = rungs + list(dict.fromkeys(j["rung"] for j in joined))
     order = [p[0] for p in points]
     rows = sorted(rows + joined, key=lambda r: (order.index(r["point"]), rungs.index(r["rung"])))
     errors(rows, rungs, args.reference)
