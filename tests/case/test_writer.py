@@ -32,6 +32,7 @@ from ehlfoam.foam.runtime import FoamRuntime
 from ehlfoam.report.case_data import read_history
 from ehlfoam.run.monitor import (FRONT_CELL_WARNING, OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, front_cell_warnings, rear_cell_warnings, run_case)
 from ehlfoam.notices import to_text
+from tests.hostile import procs
 from tests.tiny import SMALL
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -997,21 +998,17 @@ def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
     assert saved["status"] == "failed"
 
 
-def _solver_of(case: Path, timeout: float = 120.0) -> int:
-    """The pid of the solver running in ``case`` (the runtime's loader, its working folder
-    the case), once the case has a write past 0."""
-    t0 = time.monotonic()
-    while time.monotonic() - t0 < timeout:
-        for pid in (d for d in os.listdir("/proc") if d.isdigit()):
-            try:
-                cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
-                here = os.readlink(f"/proc/{pid}/cwd") == str(case)
-            except OSError:
-                continue
-            if here and b"interFoam" in cmd and len(case_fields.time_folders(case)) > 1:
-                return int(pid)
-        time.sleep(0.05)
-    raise AssertionError(f"no solver ran in {case}")
+def _solver_of(run: subprocess.Popen, case: Path, timeout: float = 120.0) -> int:
+    """The pid of the solver the ``ehlfoam run`` process ``run`` started, once ``case`` has a
+    write past 0."""
+    found: list[int] = []
+
+    def writing() -> bool:
+        found[:] = [p for p in procs.tree(run.pid) if "interFoam" in procs.command_line(p)]
+        return bool(found) and len(case_fields.time_folders(case)) > 1
+
+    procs.wait_for(writing, run, timeout, f"a solver writing in {case}", step=0.05)
+    return found[0]
 
 
 @pytest.mark.openfoam
@@ -1028,7 +1025,7 @@ def test_a_solver_killed_by_a_signal_says_which(tmp_path, sig, end, words):
     proc = subprocess.Popen([*EHLFOAM, "run", str(case), "--quiet", "--wall-limit", "120"],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        os.kill(_solver_of(case), sig)
+        os.kill(_solver_of(proc, case), sig)
     finally:
         out = proc.communicate(timeout=180)[0]
     m = json.loads((case / "metrics.json").read_text())
