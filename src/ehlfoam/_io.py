@@ -1,4 +1,5 @@
-"""Atomic file writes and TOML reading: the bottom of the package, used by every layer.
+"""Atomic file writes, TOML reading and a huge file's last lines: the bottom of the package,
+used by every layer.
 
 Every file is written to a temporary sibling and renamed into place, so a reader (another
 process, a resumed batch, a report) never sees a half-written file.
@@ -19,7 +20,7 @@ from typing import IO, Any
 from ehlfoam.errors import SpecError
 
 __all__ = ["MAX_SPEC_BYTES", "atomic_write", "atomic_write_json", "atomic_write_text",
-           "finite_or_none", "link_tree", "read_toml"]
+           "finite_or_none", "link_tree", "read_toml", "tail_lines"]
 
 #: The largest spec file read [bytes]: a spec is a few kB (a mesh.refine band of 10,000
 #: points some 0.3 MB); a larger file is refused by its size, before it is read.
@@ -105,3 +106,22 @@ def read_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise SpecError(f"{name}: not valid TOML ({err})") from None
+
+
+def tail_lines(path: str | os.PathLike[str], n: int | None = None,
+               chunk: int = 65536) -> list[str]:
+    """The last ``n`` lines (None: all) of the last ``chunk`` bytes of a (possibly huge) text
+    file, reading only its end (a long run's solver log is hundreds of MB); the line the
+    chunk cuts is dropped; none without the file."""
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(0, os.SEEK_END)
+            size = fh.tell()
+            fh.seek(max(0, size - chunk))
+            data = fh.read()
+    except OSError:
+        return []
+    lines = data.decode("utf-8", "replace").splitlines()
+    if size > chunk and lines:
+        lines = lines[1:]          # the first line is cut
+    return lines if n is None else lines[-n:]

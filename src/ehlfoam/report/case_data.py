@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from ehlfoam._io import tail_lines
 from ehlfoam.case.geometry import META, CaseGeometry
 from ehlfoam.case.ownership import run_lock_held
 from ehlfoam.metrics.record import read_metrics
@@ -136,22 +137,6 @@ def _load_spec(case: Path, problems: list[str]) -> tuple[Any, dict]:
         return None, raw
 
 
-def tail_lines(path: Path, n: int = LOG_TAIL_LINES, chunk: int = 65536) -> list[str]:
-    """The last ``n`` lines of a (possibly huge) text file, reading only its end."""
-    try:
-        with open(path, "rb") as fh:
-            fh.seek(0, os.SEEK_END)
-            size = fh.tell()
-            fh.seek(max(0, size - chunk))
-            data = fh.read()
-    except OSError:
-        return []
-    lines = data.decode("utf-8", "replace").splitlines()
-    if size > chunk and lines:
-        lines = lines[1:]          # the first line is cut
-    return lines[-n:]
-
-
 def log_header(path: Path) -> dict[str, str]:
     """Build, Exec, Case, nProcs... from the banner at the top of an OpenFOAM log."""
     out: dict[str, str] = {}
@@ -234,7 +219,7 @@ def load_case(case: str | os.PathLike) -> CaseInfo:
     except (OSError, csv.Error) as exc:
         problems.append(f"history.csv unreadable ({exc})")
         history = None
-    tail = tail_lines(log) if log else []
+    tail = tail_lines(log, LOG_TAIL_LINES) if log else []
     if not tail and metrics and metrics.get("log_tail"):
         tail = list(metrics["log_tail"])
     precalc = _read_json(case / "precalc" / "summary.json", problems)

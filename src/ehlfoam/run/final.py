@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from ehlfoam._io import tail_lines
 from ehlfoam.case.geometry import CaseGeometry, mesh_warnings
 from ehlfoam.notices import to_text
 from ehlfoam.metrics.record import MetricsRecord
@@ -25,8 +26,9 @@ LOG_TAIL_LINES = 20
 @dataclass(frozen=True)
 class RunEnd:
     """How the solver's run ended: ``reason`` (steady, end_time, wall_limit, diverged,
-    crashed, interrupted), whether it ``failed``, its ``exit_code``, the ``time_steps`` it took, its
-    last time step [s], its wall-clock time [s] and the steady-state test that stopped it."""
+    crashed, interrupted), whether it ``failed``, its ``exit_code``, the ``time_steps`` it
+    took, its last time step [s], its wall-clock time [s] and the steady-state test that
+    stopped it."""
 
     reason: str
     failed: bool
@@ -95,9 +97,6 @@ def final_record(case: Path, spec: CaseSpec, geom: CaseGeometry,
             + (boundary_warnings(off_outlet, pattern) if surrounded else [])),
     }
     if end.failed:
-        log = case / geom.log_name
-        lines = log.read_text(errors="replace").splitlines()[-LOG_TAIL_LINES:] \
-            if log.exists() else []
-        out["log_tail"] = lines
+        out["log_tail"] = tail_lines(case / geom.log_name, LOG_TAIL_LINES)
     out["steady_test"] = end.steady_test
     return MetricsRecord.model_validate(out)

@@ -11,6 +11,7 @@ import shutil
 import signal
 from pathlib import Path
 
+from ehlfoam._io import tail_lines
 from ehlfoam.case.geometry import CaseGeometry
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run import fields as case_fields
@@ -79,7 +80,8 @@ def end_reason(reason: str | None, detail: str | None, *, exit_code: int | None,
             detail = (f"{geom.solver} stopped before its first time step (exit code "
                       f"{exit_code}): {_log_reason(case, geom)}")
         else:
-            sig = _signal(exit_code, case, geom)
+            tail = "\n".join(tail_lines(case / geom.log_name))   # the signal, the error
+            sig = _signal(exit_code, tail)
             after = f"after {logged_steps} time steps"
             if sig is not None and sig[0] != signal.SIGFPE:
                 reason = CRASHED
@@ -89,37 +91,24 @@ def end_reason(reason: str | None, detail: str | None, *, exit_code: int | None,
             else:
                 reason = "diverged"
                 how = (f"signal {sig[0]} ({sig[1]}), a floating-point trap" if sig else
-                       _fatal_error(case, geom) or f"exit code {exit_code}")
+                       _fatal_error(tail) or f"exit code {exit_code}")
                 detail = f"{geom.solver} failed {after}: {how}"
     failed = reason in ("diverged", CRASHED, START_FAILED, MONITOR_ERROR) or (
         exit_code not in (0, None, -9) and reason != "interrupted")
     return reason, failed, detail
 
 
-def _log_text(case: Path, geom: CaseGeometry, tail: int | None = 65536) -> str:
-    """The solver log's last ``tail`` bytes (None: all of it), '' without a log; a signal's
-    or a fatal error's words are at its end, and a long run's log is hundreds of MB."""
-    try:
-        with open(case / geom.log_name, "rb") as fh:
-            if tail is not None:
-                fh.seek(0, 2)
-                fh.seek(max(fh.tell() - tail, 0))
-            return fh.read().decode(errors="replace")
-    except OSError:
-        return ""
+def _fatal_error(log: str) -> str | None:
+    """The ``FOAM FATAL ERROR`` of the solver log's text ``log`` in one line, None without
+    one."""
+    return failure_from_log(log) if "FOAM FATAL" in log else None
 
 
-def _fatal_error(case: Path, geom: CaseGeometry) -> str | None:
-    """The solver log's ``FOAM FATAL ERROR`` in one line, None without one."""
-    text = _log_text(case, geom)
-    return failure_from_log(text) if "FOAM FATAL" in text else None
-
-
-def _signal(exit_code: int | None, case: Path, geom: CaseGeometry) -> tuple[int, str] | None:
-    """The signal (number, name) that killed the solver: read from its log, else from its
-    exit code (negative: the signal; above 128: 128 + the signal, as a shell or mpirun passes
-    it on). None for an error exit."""
-    found = _SIGNAL_LINE.findall(_log_text(case, geom))
+def _signal(exit_code: int | None, log: str) -> tuple[int, str] | None:
+    """The signal (number, name) that killed the solver: read from its log's text ``log``
+    (its tail), else from its exit code (negative: the signal; above 128: 128 + the signal,
+    as a shell or mpirun passes it on). None for an error exit."""
+    found = _SIGNAL_LINE.findall(log)
     if found:
         number, name = int(found[0][0]), found[0][1].strip()
     elif exit_code is not None and (exit_code < 0 or 128 < exit_code < 160):
@@ -134,9 +123,11 @@ def _signal(exit_code: int | None, case: Path, geom: CaseGeometry) -> tuple[int,
 
 
 def _log_reason(case: Path, geom: CaseGeometry) -> str:
-    if not (case / geom.log_name).is_file():
+    try:
+        text = (case / geom.log_name).read_text(errors="replace")
+    except OSError:
         return "no solver log"
-    return failure_from_log(_log_text(case, geom, tail=None)) or "an empty solver log"
+    return failure_from_log(text) or "an empty solver log"
 
 
 def write_end(case: Path, spec: CaseSpec, geom: CaseGeometry,
