@@ -267,13 +267,12 @@ def main(argv: list[str] | None = None) -> int:
         joined = joined_rows(args.join, [p[0] for p in points], rungs)
     except (SpecError, ValueError) as err:
         ap.error(str(err))
-    known = rungs + [j["rung"] for j in joined]
-    if args.reference is not None and args.reference not in known:
+    rungs = rungs + list(dict.fromkeys(j["rung"] for j in joined))   # joined: the finest
+    if args.reference is not None and args.reference not in rungs:
         ap.error(f"--reference {args.reference}: not a rung run or joined here "
-                 f"({', '.join(dict.fromkeys(known))})")
+                 f"({', '.join(rungs)})")
     with work_folder(args.work) as work:
         rows = run_all(specs, args.jobs, work)
-    rungs = rungs + list(dict.fromkeys(j["rung"] for j in joined))
     order = [p[0] for p in points]
     rows = sorted(rows + joined, key=lambda r: (order.index(r["point"]), rungs.index(r["rung"])))
     errors(rows, rungs, args.reference)
