@@ -17,8 +17,8 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
-from foamlib import FoamFieldFile
 
+from ehlfoam.foam.fieldfile import field_file
 from ehlfoam.mesh import PolyMesh
 
 __all__ = ["columns", "film_history", "rear_films", "wall_rows"]
@@ -70,7 +70,7 @@ def film_history(writes: Iterable[tuple[float, Path]], mesh: PolyMesh, a: float,
     ``t_s``."""
     rows = []
     for t, folder in writes:
-        alpha = np.asarray(FoamFieldFile(Path(folder) / "alpha.oil").internal_field, float)
+        alpha = np.asarray(field_file(Path(folder) / "alpha.oil").internal_field, float)
         row = rear_films(mesh, alpha, a, x_out)
         if row is not None:
             rows.append({"t_s": t, **row})
@@ -90,9 +90,9 @@ def wall_rows(folder: Path, mesh: PolyMesh, u: float, x_m: float, reach: float) 
     - ``wall_pressure_excess_pa``: the median of the wall cells' p_rgh over their mid-gap
       cell's in those columns [Pa]: the contact angle's curvature on that air.
     """
-    alpha = np.asarray(FoamFieldFile(folder / "alpha.oil").internal_field, float)
-    ux = np.asarray(FoamFieldFile(folder / "U").internal_field, float)[:, 0]
-    p = np.asarray(FoamFieldFile(folder / "p_rgh").internal_field, float)
+    alpha = np.asarray(field_file(folder / "alpha.oil").internal_field, float)
+    ux = np.asarray(field_file(folder / "U").internal_field, float)[:, 0]
+    p = np.asarray(field_file(folder / "p_rgh").internal_field, float)
     n = int(mesh.layer.max()) + 1
     cols = np.zeros((int(mesh.base_cell.max()) + 1, n), int)
     cols[mesh.base_cell, mesh.layer] = np.arange(mesh.n_cells)

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ehlfoam.case.geometry import CaseGeometry
+from ehlfoam.foam.fieldfile import is_complete
 from ehlfoam.metrics import pattern as flow
 from ehlfoam.run.fields import Structure, column_raster, time_folders
 
@@ -32,22 +33,11 @@ FIELD_NAMES = ("alpha.oil", "U", "p", "p_rgh")
 TRIES = 3
 
 
-def _complete(path: Path) -> bool:
-    """OpenFOAM finished writing ``path`` (its closing banner is there)."""
-    try:
-        with open(path, "rb") as fh:
-            fh.seek(0, os.SEEK_END)
-            fh.seek(max(0, fh.tell() - 200))
-            return b"// ****" in fh.read()
-    except OSError:
-        return False
-
-
 def newest_complete_time(case: Path) -> tuple[float, Path] | None:
     """(time [s], folder) of the newest time folder (after 0) whose alpha.oil is complete."""
     folders = time_folders(case)
     for t, folder in reversed(folders[-TRIES:]):
-        if _complete(folder / "alpha.oil"):
+        if is_complete(folder / "alpha.oil"):
             return t, folder
     return None
 

@@ -18,6 +18,7 @@ from scipy.spatial import cKDTree
 
 from ehlfoam.case.dictionaries import AIR_GAS_CONSTANT
 from ehlfoam.case.geometry import META, CaseGeometry
+from ehlfoam.foam.fieldfile import field_file
 
 from ehlfoam.metrics import pattern as metrics
 
@@ -171,9 +172,9 @@ def pattern_geometry(geom: CaseGeometry) -> metrics.Geometry:
 
 def _read_alpha(path: Path, structure: Structure) -> tuple[np.ndarray, FoamFieldFile]:
     """The oil fraction per cell of the alpha.oil file ``path`` (and the file, for its
-    boundary values)."""
+    boundary values); IncompleteField (a ValueError) while OpenFOAM has not finished it."""
     n = len(structure.cell_volumes)
-    file = FoamFieldFile(path)
+    file = field_file(path)
     alpha = uniform_or_list(file.internal_field, n)
     if alpha.shape != (n,):
         raise ValueError(f"{path} has {alpha.shape} values, expected {n}")
@@ -208,7 +209,7 @@ def smeared_oil_fraction(alpha: np.ndarray, cell_volumes: np.ndarray) -> float |
 def read_alpha(path: Path, structure: Structure) -> np.ndarray:
     """The oil fraction per cell of the alpha.oil file ``path``, once OpenFOAM has finished
     writing it (raises ValueError while it has not)."""
-    return _read_alpha(_complete(path), structure)[0]
+    return _read_alpha(path, structure)[0]
 
 
 def mid_gap_alpha(folder: Path, structure: Structure, geom: CaseGeometry) -> np.ndarray:
@@ -230,23 +231,9 @@ def mid_gap_raster(alpha: np.ndarray, structure: Structure,
     return column_raster(structure.mid_gap(alpha, geom.n_layers), structure, geom)
 
 
-def _complete(path: Path) -> Path:
-    """``path`` if OpenFOAM finished writing it (its closing banner is there), else raise:
-    a truncated list can send a regex-based parser into endless backtracking."""
-    with open(path, "rb") as fh:
-        fh.seek(0, 2)
-        fh.seek(max(0, fh.tell() - 200))
-        if b"// ****" not in fh.read():
-            raise ValueError(f"{path} is incomplete (still being written?)")
-    return path
-
-
 def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     """Read one time folder. Raises (OSError, ValueError, KeyError...) while the folder is
     still being written; the caller retries."""
-    for name in ("alpha.oil", "phi", "alphaPhi0.oil"):
-        if (folder / name).exists() or name == "alpha.oil":
-            _complete(folder / name)
     alpha, alpha_file = _read_alpha(folder / "alpha.oil", structure)
     volume = _oil_volume(alpha, structure, geom)
     # the oil flux MULES transported (alphaPhi0.oil); where the solver does not write it
@@ -255,7 +242,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     # the domain; the written face values of inflow faces there are not what was transported)
     oil_flux_file = folder / "alphaPhi0.oil"
     exact = oil_flux_file.exists()
-    flux_bf = FoamFieldFile(oil_flux_file if exact else folder / "phi").boundary_field
+    flux_bf = field_file(oil_flux_file if exact else folder / "phi").boundary_field
     alpha_bf = alpha_file.boundary_field
 
     def oil_flux(name: str, size: int) -> np.ndarray:
@@ -273,7 +260,7 @@ def sample(folder: Path, structure: Structure, geom: CaseGeometry) -> Sample:
     pattern["bubble_volume_m3"] = _bubble_volume(r, alpha, structure, geom)
     pattern["oil_smeared_fraction"] = smeared_oil_fraction(alpha, structure.cell_volumes)
     p_file = folder / "p"
-    p = (uniform_or_list(FoamFieldFile(_complete(p_file)).internal_field, len(alpha))
+    p = (uniform_or_list(field_file(p_file).internal_field, len(alpha))
          if p_file.exists() else None)
     pattern["min_pressure_Pa"] = _min_pressure(p, geom)
     pattern["gas_release_m3_s"] = gas_release(p, alpha, structure.cell_volumes, geom)
@@ -329,7 +316,7 @@ def _in_out(face_flux, structure: Structure,
 def volume_flux(folder: Path, structure: Structure, geom: CaseGeometry) -> tuple[float, float]:
     """The total volume flux [m3/s, whole contact] in and out through the open boundaries at
     one written time, from its phi (oil and gas together)."""
-    phi = FoamFieldFile(_complete(folder / "phi")).boundary_field
+    phi = field_file(folder / "phi").boundary_field
     q_in, q_out, _ = _in_out(lambda name, size: uniform_or_list(phi[name]["value"], size),
                              structure, geom)
     return q_in, q_out
@@ -340,13 +327,13 @@ def _gas(folder: Path, alpha: np.ndarray, p: np.ndarray, structure: Structure,
     """Air mass [kg] in the gap and its mass fluxes [kg/s] in and out through the open
     boundaries (whole contact) of a compressible scene: density p/(R T) of the perfect gas
     (``p`` [Pa] per cell), volumetric gas flux phi - alphaPhi0.oil on the boundary faces."""
-    temp_file = FoamFieldFile(_complete(folder / "T"))
+    temp_file = field_file(folder / "T")
     temp = uniform_or_list(temp_file.internal_field, len(alpha))
     gas = 1.0 - np.clip(alpha, 0.0, 1.0)
     mass = geom.mirror * float(np.sum(gas * p / (AIR_GAS_CONSTANT * temp) * structure.cell_volumes))
-    phi = FoamFieldFile(_complete(folder / "phi")).boundary_field
-    oil = FoamFieldFile(_complete(folder / "alphaPhi0.oil")).boundary_field
-    p_b, t_b = FoamFieldFile(folder / "p").boundary_field, temp_file.boundary_field
+    phi = field_file(folder / "phi").boundary_field
+    oil = field_file(folder / "alphaPhi0.oil").boundary_field
+    p_b, t_b = field_file(folder / "p").boundary_field, temp_file.boundary_field
 
     def gas_mass_flux(name: str, size: int) -> np.ndarray:
         q = (uniform_or_list(phi[name]["value"], size)

@@ -16,10 +16,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from foamlib import FoamFieldFile
 
 from ehlfoam._io import atomic_write_text
 from ehlfoam.case.geometry import META, load_geometry, load_spec_of
+from ehlfoam.foam.fieldfile import field_file, is_complete
 from ehlfoam.run.fields import Structure, time_folders, uniform_or_list
 
 __all__ = ["OUTFLOW_FILE", "OUTFLOW_ROW", "OUTLET", "outlet_layers", "write_outflow"]
@@ -36,7 +36,8 @@ def outlet_layers(case: str | Path, row: float, rows: int,
                   time_folder: Path | None = None) -> np.ndarray:
     """The layer [m] (both walls together) the oil leaving the 3D ``case``'s outlet lays on
     each of ``rows`` rows of width ``row`` [m] from y = 0 (the faces beyond the last row in
-    it), at ``time_folder`` (default: the last written time); the oil that flows back in
+    it), at ``time_folder`` (default: the last written time whose flux is written whole: a
+    solver killed while it wrote leaves a folder cut short); the oil that flows back in
     through the outlet is taken from its row. ValueError without an outlet or a written
     time."""
     case = Path(case)
@@ -45,7 +46,7 @@ def outlet_layers(case: str | Path, row: float, rows: int,
     if OUTLET not in structure.patches:
         raise ValueError(f"{case} has no {OUTLET!r} patch")
     if time_folder is None:
-        written = [f for t, f in time_folders(case) if t > 0]
+        written = [f for t, f in time_folders(case) if t > 0 and _written_whole(f)]
         if not written:
             raise ValueError(f"{case} has no written time after the start")
         time_folder = written[-1]
@@ -58,14 +59,21 @@ def outlet_layers(case: str | Path, row: float, rows: int,
     return per_row / (spec.speed * row * (1.0 if geom.symmetric else 2.0))
 
 
+def _written_whole(folder: Path) -> bool:
+    """The flux files the outlet's oil is read from are complete in ``folder``."""
+    if (folder / "alphaPhi0.oil").exists():
+        return is_complete(folder / "alphaPhi0.oil")
+    return is_complete(folder / "phi") and is_complete(folder / "alpha.oil")
+
+
 def _outlet_oil_flux(folder: Path, size: int) -> np.ndarray:
     """The oil flux [m3/s] out through each outlet face at ``folder``."""
     exact = (folder / "alphaPhi0.oil").exists()
-    flux = uniform_or_list(FoamFieldFile(folder / ("alphaPhi0.oil" if exact else "phi"))
+    flux = uniform_or_list(field_file(folder / ("alphaPhi0.oil" if exact else "phi"))
                            .boundary_field[OUTLET]["value"], size)
     if not exact:
         alpha = uniform_or_list(
-            FoamFieldFile(folder / "alpha.oil").boundary_field[OUTLET]["value"], size)
+            field_file(folder / "alpha.oil").boundary_field[OUTLET]["value"], size)
         flux = flux * np.clip(alpha, 0.0, 1.0)
     return flux
 

@@ -25,9 +25,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from foamlib import FoamFieldFile
 
 from ehlfoam.case.geometry import META, load_geometry
+from ehlfoam.foam.fieldfile import field_file
 from ehlfoam.run.fields import Structure, time_folders
 from ehlfoam.seed.mapping import LayeredMesh, carry_oil, interpolate
 from ehlfoam.seed.write import RampError, write_seed
@@ -64,7 +64,7 @@ def same_mesh(case: str | Path, previous: str | Path) -> bool:
 
 
 def _read_internal(path: Path) -> Any:
-    return FoamFieldFile(path).internal_field
+    return field_file(path).internal_field
 
 
 def fields_to_carry(case: Path, folder: Path) -> list[str]:

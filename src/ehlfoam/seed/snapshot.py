@@ -27,11 +27,10 @@ from pathlib import Path
 from typing import Any, Iterable
 
 import numpy as np
-from foamlib import FoamFieldFile
 
 from ehlfoam._io import atomic_write
 from ehlfoam.case.geometry import META, load_geometry
-
+from ehlfoam.foam.fieldfile import field_file
 from ehlfoam.run.fields import Structure, time_folders, write_near
 from ehlfoam.seed.mapping import LayeredMesh, carry_oil, interpolate
 from ehlfoam.seed.write import check_same_gap, write_seed
@@ -118,7 +117,7 @@ def _read_write(case: Path, at: str, transit_time: float, fields: tuple[str, ...
     for t, folder in tries:
         try:
             return t, folder, {name: np.broadcast_to(   # a uniform value or a list
-                np.asarray(FoamFieldFile(folder / name).internal_field, dtype=float),
+                np.asarray(field_file(folder / name).internal_field, dtype=float),
                 (n, 3) if name == "U" else (n,)) for name in fields}
         except (OSError, ValueError) as err:
             error = f"{folder}: cannot read {', '.join(fields)} ({err})"

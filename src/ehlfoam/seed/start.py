@@ -9,10 +9,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from foamlib import FoamFieldFile
 
 from ehlfoam.case.geometry import META, load_geometry
 from ehlfoam.case.thin_film import is_thin_film_case
+from ehlfoam.foam.fieldfile import field_file
 from ehlfoam.run.fields import Structure
 from ehlfoam.seed.previous import FIELDS, final_time, seed_from_previous
 from ehlfoam.seed.snapshot import is_snapshot, load_snapshot, seed_from_snapshot
@@ -95,7 +95,7 @@ def _check_run_case(path: Path) -> None:
                         "from (an unfinished write, or not a time folder the solver wrote)")
     for name in names:
         try:
-            value = np.asarray(FoamFieldFile(folder / name).internal_field, dtype=float)
+            value = np.asarray(field_file(folder / name).internal_field, dtype=float)
         except Exception as err:  # noqa: BLE001 - foamlib's parse errors
             raise RampError(f"{path}: {folder.name}/{name} cannot be read as an OpenFOAM "
                             f"field ({type(err).__name__}: "
