@@ -31,6 +31,7 @@ from ehlfoam.cli.case import parse_value
 from ehlfoam.foam.runtime import FoamRuntime
 from ehlfoam.report.case_data import read_history
 from ehlfoam.run.monitor import (FRONT_CELL_WARNING, OIL_FLUX_APPROXIMATE, OIL_FLUX_EXACT, front_cell_warnings, rear_cell_warnings, run_case)
+from ehlfoam.run.watch import HANG_POLLS, POLL_S
 from ehlfoam.notices import to_text
 from tests.hostile import procs
 from tests.tiny import SMALL
@@ -993,7 +994,9 @@ def test_diverging_run_keeps_logs_and_is_marked_failed(small_case, tmp_path):
     m = run_case(case, wall_limit=120)
     assert m["status"] == "failed" and m["end_reason"] == "diverged", m
     assert (case / "log.interFoam").stat().st_size > 0
+    # the fixed step traps a floating-point exception in the numerics: the log's signal
     assert m["log_tail"] and m["reason"].startswith("interFoam failed after"), m["reason"]
+    assert "signal 8 (Floating point exception), a floating-point trap" in m["reason"]
     saved = json.loads((case / "metrics.json").read_text())
     assert saved["status"] == "failed"
 
@@ -1011,27 +1014,66 @@ def _solver_of(run: subprocess.Popen, case: Path, timeout: float = 120.0) -> int
     return found[0]
 
 
-@pytest.mark.openfoam
-@pytest.mark.parametrize("sig, end, words", [
-    (signal.SIGSEGV, "crashed", "signal 11 (Segmentation fault)"),
-    (signal.SIGFPE, "diverged", "signal 8 (Floating point exception), a floating-point trap")])
-def test_a_solver_killed_by_a_signal_says_which(tmp_path, sig, end, words):
-    """A solver that dies on a segmentation fault after its first steps (a library, memory,
-    two runs' MPI segments) crashed; on a floating-point trap its numerics diverged. Both
-    fail, keep their logs, and ``reason`` names the signal (read from the log)."""
+def _run_and_find_solver(tmp_path: Path) -> tuple[Path, subprocess.Popen, int]:
+    """A tiny case run by ``ehlfoam run`` (wall limit 300 s) and the pid of its solver, once
+    it has written past 0."""
     spec = make_case_spec({**SMALL, "run": {**SMALL["run"], "end_time": 5e-2}})
     case = tmp_path / "case"
     write_case(spec, case)
-    proc = subprocess.Popen([*EHLFOAM, "run", str(case), "--quiet", "--wall-limit", "120"],
+    proc = subprocess.Popen([*EHLFOAM, "run", str(case), "--quiet", "--wall-limit", "300"],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        os.kill(_solver_of(proc, case), sig)
+        return case, proc, _solver_of(proc, case)
+    except BaseException:
+        proc.kill()
+        raise
+
+
+@pytest.mark.openfoam
+def test_a_solver_killed_by_a_segfault_crashed(tmp_path):
+    """A solver that dies on a segmentation fault after its first steps (a library, memory,
+    two runs' MPI segments) crashed: the run fails, keeps its log, and ``reason`` names the
+    signal (read from the log). (A floating-point trap is a divergence:
+    test_diverging_run_keeps_logs_and_is_marked_failed.) A signal sent from outside may land
+    inside the C library and hang OpenFOAM's handler; the watch then kills the solver
+    (test_a_hung_solver_is_killed) and ``reason`` says so."""
+    case, proc, solver = _run_and_find_solver(tmp_path)
+    try:
+        os.kill(solver, signal.SIGSEGV)
     finally:
-        out = proc.communicate(timeout=180)[0]
+        out = proc.communicate(timeout=120)[0]
+    m = json.loads((case / "metrics.json").read_text())
+    assert (m["status"], m["end_reason"]) == ("failed", "crashed"), out
+    assert m["time_steps"] > 0 and (case / "log.interFoam").stat().st_size > 0
+    assert ("signal 11 (Segmentation fault)" in m["reason"]
+            or "still for" in m["reason"]), m["reason"]
+
+
+@pytest.mark.openfoam
+@pytest.mark.parametrize("backtrace, end, words", [
+    ("", "crashed", "its log and its CPU time were still for"),
+    ("#0  Foam::error::printStack(Foam::Ostream&) at ??\n#1  Foam::sigFpe::sigHandler(int)",
+     "diverged", "signal 8 (Floating point exception), a floating-point trap; it then hung")])
+def test_a_hung_solver_is_killed(tmp_path, backtrace, end, words):
+    """A solver whose crash handler hangs (a signal inside the C library leaves it waiting on
+    a lock, before or while it prints a backtrace) is alive, silent and idle: here it is
+    stopped (SIGSTOP), the log ending where such a handler stopped. The watch kills it after
+    HANG_POLLS still polls, long before the wall limit, and the run ends on what the log
+    says: the signal where the handler names it (a floating-point trap: diverged), crashed
+    where it names none."""
+    case, proc, solver = _run_and_find_solver(tmp_path)
+    try:
+        os.kill(solver, signal.SIGSTOP)
+        with open(case / "log.interFoam", "a") as log:   # a line the handler did not end
+            log.write(backtrace)
+        t0 = time.monotonic()
+    finally:
+        out = proc.communicate(timeout=120)[0]
+    waited = time.monotonic() - t0
     m = json.loads((case / "metrics.json").read_text())
     assert (m["status"], m["end_reason"]) == ("failed", end), out
     assert words in m["reason"] and m["time_steps"] > 0, m["reason"]
-    assert (case / "log.interFoam").stat().st_size > 0
+    assert waited >= (HANG_POLLS - 1) * POLL_S, waited   # and ended long before 300 s
 
 
 @pytest.mark.openfoam

@@ -74,7 +74,8 @@ class MetricsRecord(BaseModel):
     end_reason: str | None = _text(
         "Why the run ended: steady, end_time, wall_limit, diverged (the solver failed after "
         "its first time step: a floating-point trap, a fatal error), crashed (killed by "
-        "another signal after it: a segmentation fault, an out-of-memory kill), "
+        "another signal after it: a segmentation fault, an out-of-memory kill; or hung, "
+        "killed by the monitor), "
         "start_failed (before it: decomposition, a path OpenFOAM refuses, a solver that "
         "cannot start; reason has the log's words), case_removed (the "
         "case folder was removed mid-run), monitor_error, interrupted (Ctrl-C, SIGTERM), "

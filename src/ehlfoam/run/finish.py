@@ -30,6 +30,9 @@ MONITOR_ERROR = "monitor_error"
 #: The signal the solver's log names: UCX's handler ("Caught signal 11 (Segmentation fault:
 #: ...") in every solver of the runtime, mpirun ("exited on signal 11 (Segmentation fault)").
 _SIGNAL_LINE = re.compile(r"(?:Caught|exited on) signal (\d+) \(([^:)]*)")
+#: OpenFOAM's own handlers, in the second frame of the backtrace they print
+_HANDLER_FRAME = re.compile(r"Foam::sig(Fpe|Segv|Quit)::sigHandler")
+_HANDLED = {"Fpe": signal.SIGFPE, "Segv": signal.SIGSEGV, "Quit": signal.SIGQUIT}
 
 
 def one_line(err: BaseException) -> str:
@@ -65,13 +68,15 @@ def trim_past_stop(case: Path, history: list[case_fields.Sample],
 
 
 def end_reason(reason: str | None, detail: str | None, *, exit_code: int | None,
-               logged_steps: int, case: Path, geom: CaseGeometry
-               ) -> tuple[str, bool, str | None]:
+               logged_steps: int, case: Path, geom: CaseGeometry,
+               hang_s: float | None = None) -> tuple[str, bool, str | None]:
     """The run's end reason, whether it failed, and the words that say why (``detail``
     unless the end is found only now). ``reason``: the one the watch found, or None: then
-    the solver's ``exit_code`` says it (0: ``end_time``; no time step logged:
-    ``start_failed``, with the log's words; killed by a signal other than a floating-point
-    trap: ``crashed``, the signal named; otherwise ``diverged``, with the log's words)."""
+    the solver's exit says it (0: ``end_time``; no time step logged: ``start_failed``, with
+    the log's words; killed by a signal other than a floating-point trap: ``crashed``, the
+    signal named; otherwise ``diverged``, with the log's words). A solver the watch killed
+    as hung, after ``hang_s`` [s] still, ended on the signal its log names (a crash handler
+    that hung), not on the kill; ``crashed`` where the log names none."""
     if reason is None:
         if exit_code == 0:
             reason = "end_time"
@@ -80,22 +85,31 @@ def end_reason(reason: str | None, detail: str | None, *, exit_code: int | None,
             detail = (f"{geom.solver} stopped before its first time step (exit code "
                       f"{exit_code}): {_log_reason(case, geom)}")
         else:
-            tail = "\n".join(tail_lines(case / geom.log_name))   # the signal, the error
-            sig = _signal(exit_code, tail)
-            after = f"after {logged_steps} time steps"
-            if sig is not None and sig[0] != signal.SIGFPE:
-                reason = CRASHED
-                detail = (f"{geom.solver} was killed by signal {sig[0]} ({sig[1]}) {after}: "
-                          "a crash (memory, MPI, a library), not a floating-point trap of "
-                          "the numerics; the log has its backtrace")
-            else:
-                reason = "diverged"
-                how = (f"signal {sig[0]} ({sig[1]}), a floating-point trap" if sig else
-                       _fatal_error(tail) or f"exit code {exit_code}")
-                detail = f"{geom.solver} failed {after}: {how}"
+            reason, detail = _failure(exit_code, logged_steps, case, geom, hang_s)
     failed = reason in ("diverged", CRASHED, START_FAILED, MONITOR_ERROR) or (
         exit_code not in (0, None, -9) and reason != "interrupted")
     return reason, failed, detail
+
+
+def _failure(exit_code: int | None, logged_steps: int, case: Path, geom: CaseGeometry,
+             hang_s: float | None) -> tuple[str, str]:
+    """(``crashed`` or ``diverged``, why) for a solver that failed after its first steps."""
+    tail = "\n".join(tail_lines(case / geom.log_name))   # the signal, the error
+    sig = _signal(None if hang_s else exit_code, tail)
+    after = f"after {logged_steps} time steps"
+    hung = (f"; it then hung in its crash handler: still for {hang_s:g} s, killed"
+            if hang_s else "")
+    if sig is not None and sig[0] != signal.SIGFPE:
+        return CRASHED, (f"{geom.solver} was killed by signal {sig[0]} ({sig[1]}) {after}: "
+                         "a crash (memory, MPI, a library), not a floating-point trap of the "
+                         f"numerics; the log has its backtrace{hung}")
+    if sig is None and hang_s:
+        return CRASHED, (f"{geom.solver} hung {after}: its log and its CPU time were still "
+                         f"for {hang_s:g} s (a crash handler waiting on a lock, a deadlock; "
+                         "the signal, if any, is not known), killed")
+    how = (f"signal {sig[0]} ({sig[1]}), a floating-point trap" if sig else
+           _fatal_error(tail) or f"exit code {exit_code}")
+    return "diverged", f"{geom.solver} failed {after}: {how}{hung}"
 
 
 def _fatal_error(log: str) -> str | None:
@@ -106,20 +120,26 @@ def _fatal_error(log: str) -> str | None:
 
 def _signal(exit_code: int | None, log: str) -> tuple[int, str] | None:
     """The signal (number, name) that killed the solver: read from its log's text ``log``
-    (its tail), else from its exit code (negative: the signal; above 128: 128 + the signal,
-    as a shell or mpirun passes it on). None for an error exit."""
+    (its tail: a signal line, else the OpenFOAM handler in its backtrace), else from its exit
+    code (negative: the signal; above 128: 128 + the signal, as a shell or mpirun passes it
+    on). None for an error exit."""
     found = _SIGNAL_LINE.findall(log)
     if found:
-        number, name = int(found[0][0]), found[0][1].strip()
-    elif exit_code is not None and (exit_code < 0 or 128 < exit_code < 160):
-        number = -exit_code if exit_code < 0 else exit_code - 128
-        try:
-            name = signal.strsignal(number) or f"signal {number}"
-        except ValueError:
-            name = f"signal {number}"
-    else:
-        return None
-    return number, name
+        return int(found[0][0]), found[0][1].strip()
+    handler = _HANDLER_FRAME.search(log)
+    if handler:
+        return _named(_HANDLED[handler.group(1)])
+    if exit_code is not None and (exit_code < 0 or 128 < exit_code < 160):
+        return _named(-exit_code if exit_code < 0 else exit_code - 128)
+    return None
+
+
+def _named(number: int) -> tuple[int, str]:
+    """(``number``, the signal's name)."""
+    try:
+        return number, signal.strsignal(number) or f"signal {number}"
+    except ValueError:
+        return number, f"signal {number}"
 
 
 def _log_reason(case: Path, geom: CaseGeometry) -> str:

@@ -1,5 +1,6 @@
-"""The solver log read as it grows: the time steps (each one's simulated time and deltaT) and
-the run of consecutive collapsed steps the monitor calls divergence."""
+"""The solver log read as it grows: the time steps (each one's simulated time and deltaT),
+the run of consecutive collapsed steps the monitor calls divergence, whether it grew since
+the last read, and whether a backtrace has begun (a crash handler at work)."""
 
 from __future__ import annotations
 
@@ -12,16 +13,20 @@ from pathlib import Path
 __all__ = ["LogTail"]
 
 _STEP_OR_TIME = re.compile(r"^(deltaT|Time) = ([-+0-9.eE]+)\s*$", re.M)
+#: a crash handler's first words: OpenFOAM's backtrace, UCX's
+_BACKTRACE = re.compile(r"^#0 +Foam::error::printStack|Caught signal \d+", re.M)
 
 
 class LogTail:
     """Incremental reader of the solver log: its time steps (each one's time and deltaT),
-    and the run of consecutive collapsed steps."""
+    the run of consecutive collapsed steps, whether the last :meth:`update` found it grown,
+    and whether a backtrace has begun."""
 
     def __init__(self, path: Path):
         self.path, self.offset, self.small_steps = path, 0, 0
         self.times, self.dts = array("d"), array("d")
         self._dt = math.nan
+        self.backtrace, self.grew, self._size = False, False, 0
 
     @property
     def steps(self) -> int:
@@ -46,7 +51,13 @@ class LogTail:
                 fh.seek(self.offset)
                 chunk = fh.read()
         except FileNotFoundError:
+            self.grew = False
             return
+        self.grew = self.offset + len(chunk) > self._size
+        self._size = max(self._size, self.offset + len(chunk))
+        # a handler may hang in the middle of a line: its words are looked for in that too
+        self.backtrace = self.backtrace or _BACKTRACE.search(
+            chunk.decode("utf-8", "replace")) is not None
         cut = chunk.rfind(b"\n") + 1
         self.offset += cut
         text = chunk[:cut].decode("utf-8", "replace")

@@ -20,7 +20,9 @@ solver at once (``stopAt writeNow``). End reasons:
   error) or its time step collapsed; the logs stay and metrics.json says ``status: failed``;
 - ``crashed``: the solver was killed after its first time step by another signal (a
   segmentation fault, a bus error, an out-of-memory kill): not the numerics; ``reason``
-  names the signal, the logs stay, ``status: failed``;
+  names the signal, the logs stay, ``status: failed``. Also a solver the watch found hung
+  (:data:`~ehlfoam.run.watch.HANG_POLLS`) and killed, its signal named where its log has
+  one (a floating-point trap: ``diverged``);
 - ``start_failed``: the run failed before its first time step (decomposition, OpenFOAM
   refusing the case's path, a solver that cannot start); ``reason`` has the log's words
   (:mod:`ehlfoam.run.start`);

@@ -3,11 +3,12 @@ starts it; the end reasons are listed there).
 
 The case is prepared and its solver started as a child process (:mod:`ehlfoam.run.start`);
 every poll reads the time folders it has written into the history (``DIR/history.csv``),
-applies the steady-state test to each new write in turn, and watches the wall limit and the
-time step (:class:`~ehlfoam.run.logtail.LogTail`). A steady run ends at the next scheduled
-write (controlDict's ``endTime`` set to it); a wall limit or an interrupt stops the solver at
-once (``stopAt writeNow``). Once the solver has exited, :mod:`ehlfoam.run.finish` writes what
-the run leaves.
+applies the steady-state test to each new write in turn, and watches the wall limit, the
+time step (:class:`~ehlfoam.run.logtail.LogTail`) and a solver that hangs. A steady run ends
+at the next scheduled write (controlDict's ``endTime`` set to it); a wall limit or an
+interrupt stops the solver at once (``stopAt writeNow``); a hung solver is killed
+(:data:`HANG_POLLS`). Once the solver has exited, :mod:`ehlfoam.run.finish` writes what the
+run leaves.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from typing import IO
 from foamlib import FoamFile
 
 from ehlfoam.case.geometry import META, CaseGeometry
+from ehlfoam.foam.cpu import tree_cpu_s
 from ehlfoam.foam.runtime import FoamError, FoamRuntime
 from ehlfoam.metrics.record import MetricsRecord, write_metrics
 from ehlfoam.run import fields as case_fields
@@ -38,13 +40,21 @@ from ehlfoam.run.start import START_FAILED, StartFailed, prepare_case, reconstru
 from ehlfoam.run.steady import steady_test
 from ehlfoam.spec.case import CaseSpec
 
-__all__ = ["DT_COLLAPSE", "DT_COLLAPSE_STEPS", "OnSample", "POLL_S", "STOP_GRACE_S",
-           "SolverWatch", "WatchedCase", "set_stop"]
+__all__ = ["DT_COLLAPSE", "DT_COLLAPSE_STEPS", "HANG_POLLS", "OnSample", "POLL_S",
+           "STOP_GRACE_S", "SolverWatch", "WatchedCase", "set_stop"]
 
 POLL_S = 1.0
 STOP_GRACE_S = 120.0
 DT_COLLAPSE = 1e-4          # time step below this fraction of maxDeltaT counts as collapse
 DT_COLLAPSE_STEPS = 200     # ... for this many consecutive logged steps
+#: a solver still for this many polls in a row hangs, and is killed: its log did not grow,
+#: and it either used no CPU or had begun a backtrace (a crash handler; printing one takes
+#: well under a second). A signal that lands inside the C library (a write, a malloc) can
+#: leave OpenFOAM's handler waiting forever on a lock the interrupted code holds, before or
+#: while it prints; the solver would hold its case to the wall limit. Counted in polls, not
+#: seconds: a watch stopped with its solver (Ctrl-Z) and resumed counts from where it was.
+HANG_POLLS = 20
+_CPU_ADVANCE_S = 0.02       # less CPU than this between two polls is none
 
 #: called with each new sample of the run and the case's geometry
 OnSample = Callable[[case_fields.Sample, CaseGeometry], None]
@@ -93,6 +103,8 @@ class SolverWatch:
         self.reason: str | None = None
         self.detail: str | None = None
         self.steady_kind: str | None = None
+        self.hang_s: float | None = None
+        self._still_polls, self._cpu_s = 0, None
         self.tested, self.steady_at, self.stop_at = 0, 0.0, math.nan
         self.proc: subprocess.Popen | None = None
         self.ident = _identity(run.path)
@@ -181,6 +193,9 @@ class SolverWatch:
             self._collect(exited=exited)
             if exited:
                 return
+            if self.hang_s is None and self._hung():
+                self.hang_s = HANG_POLLS * POLL_S
+                self.proc.kill()      # the next poll finds it exited
             over_wall = time.monotonic() - self.t_start > self.wall_limit
             if self.reason is None:
                 if self._steady():
@@ -199,6 +214,16 @@ class SolverWatch:
             elif stopping_since and time.monotonic() - stopping_since > STOP_GRACE_S:
                 self.proc.kill()
             time.sleep(POLL_S)
+
+    def _hung(self) -> bool:
+        """The solver has been still for :data:`HANG_POLLS` polls in a row (this one
+        included): its log did not grow, and it used no CPU or had begun a backtrace."""
+        cpu, last = tree_cpu_s(self.proc.pid), self._cpu_s
+        self._cpu_s = cpu
+        idle = cpu is not None and last is not None and cpu - last < _CPU_ADVANCE_S
+        still = not self.tail.grew and (self.tail.backtrace or idle)
+        self._still_polls = self._still_polls + 1 if still else 0
+        return self._still_polls >= HANG_POLLS
 
     def _steady(self) -> bool:
         """The steady-state test on every new write in turn (the first write that passes
@@ -289,7 +314,8 @@ class SolverWatch:
             self.history = trim_past_stop(case, self.history, self.stop_at)
             steps, last_dt = self.tail.steps_until(self.stop_at)
         reason, failed, detail = end_reason(self.reason, self.detail, exit_code=rc,
-                                            logged_steps=self.tail.steps, case=case, geom=geom)
+                                            logged_steps=self.tail.steps, case=case, geom=geom,
+                                            hang_s=self.hang_s)
         end = RunEnd(reason=reason, failed=failed, exit_code=rc, time_steps=steps,
                      last_delta_t=last_dt, wall_s=wall, steady_test=self.steady_kind)
         return write_end(case, run.spec, geom, run.structure, initial_oil=self.v0,
