@@ -69,6 +69,8 @@ def _copy(case: Path, tmp_path: Path) -> Path:
      "physics.gas_release_rate = 0.0", "0 < physics.gas_release_rate"),
     ("scene = \"gas-release\"\n[run]\nair_viscosity_factor = 20.0\n",
      "run.air_viscosity_factor = 20", "leave it at 100"),
+    ("scene = \"gas-release\"\n[physics]\nisotropic_compression = 1.0\n",
+     "physics.isotropic_compression = 1 does not apply", "valid range: 0"),
     ("scene = \"gas-release\"\n[physics]\ngas_dissolution_rate = 100.0\n",
      "physics.gas_dissolution_rate = 100 1/s", 'supply.mode = "submerged"'),
     ("[supply]\nmode = \"bath\"\n", "supply.mode = 'bath'", "'submerged'"),

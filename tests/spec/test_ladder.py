@@ -48,15 +48,18 @@ def test_the_resolved_rungs_generalise_the_converged_family():
 
 def test_the_gas_release_scene_s_resolved_rungs_compress_along_the_face_flux():
     """interPhaseChangeFoam diverges in the thin films with the isotropic compression: the
-    gas-release scene's resolved rungs take it from the face flux; the interface scene keeps
-    the converged family's, and a value the spec sets wins in either."""
+    gas-release scene's resolved rungs take it from the face flux, and the scene refuses any
+    other; the interface scene keeps the converged family's, and a value the spec sets
+    wins there."""
     def compression(scene, **physics):
         spec = make_case_spec({"rung": "resolved-coarse", "scene": scene,
                                "physics": physics})
         return spec.physics.isotropic_compression
 
     assert compression("gas-release") == 0.0 and compression("interface") == 1.0
-    assert compression("gas-release", isotropic_compression=0.5) == 0.5
+    with pytest.raises(SpecError, match="physics.isotropic_compression = 0.5 does not apply "
+                       'to scene = "gas-release"'):
+        compression("gas-release", isotropic_compression=0.5)
     assert compression("interface", isotropic_compression=0.0) == 0.0
     gas = make_case_spec({"rung": "resolved-coarse", "scene": "gas-release"})
     assert (gas.physics.interface_schemes, gas.physics.wall_slip_length) == ("balanced", 1e-6)

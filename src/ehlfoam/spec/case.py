@@ -258,6 +258,12 @@ def _check_scene_options(spec: CaseSpec) -> None:
             f"invalid case spec: run.air_viscosity_factor = {spec.run.air_viscosity_factor:g} "
             f"does not apply to scene = \"gas-release\", whose air has the oil's kinematic "
             f"viscosity (leave it at {default:g})")
+    compression = spec.physics.isotropic_compression
+    if spec.scene == "gas-release" and compression > 0:
+        raise SpecError(
+            f"invalid case spec: physics.isotropic_compression = {compression:g} does not apply "
+            f"to scene = \"gas-release\": interPhaseChangeFoam then turns the thin films' oil "
+            f"into gas and diverges (docs/models/gas-release.md; valid range: 0)")
     advection = spec.physics.interface_advection
     if advection == "isoadvector" and spec.scene not in ("interface", "thin-film"):
         raise SpecError(

@@ -161,9 +161,9 @@ class Physics(BaseModel):
                     "the face flux, so that a meniscus lying along the flow is hardly "
                     "compressed). At 1 an advancing contact line stands at the same place on "
                     "any cells, at an apparent angle of 30-33 deg, but a resting meniscus "
-                    "has stronger spurious currents. The resolved rungs set 1, except in the "
-                    "gas-release scene, where the thin films' oil fraction climbs past 1 with "
-                    "it and the run diverges.")
+                    "has stronger spurious currents. The resolved rungs set 1. The gas-release "
+                    "scene refuses any but 0: the thin films' oil fraction climbs past 1 "
+                    "with it and the run diverges.")
     interface_schemes: Literal["standard", "balanced"] = Field(
         "standard",
         description='"standard": the templates\' schemes; "balanced": uncorrected face '
