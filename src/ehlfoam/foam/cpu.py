@@ -19,7 +19,8 @@ _TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
 
 def tree_cpu_s(pid: int) -> float | None:
     """The CPU time [s] (user and system) process ``pid`` and its descendants (an MPI run's
-    ranks) have used so far; None where ``/proc`` cannot say (gone, or not Linux)."""
+    ranks) have used so far; None where ``/proc`` cannot say (gone, not Linux, or a kernel
+    that does not list a process's children: a rank left out would read as idle)."""
     total, todo, seen = None, [pid], set()
     while todo:
         p = todo.pop()
@@ -31,7 +32,10 @@ def tree_cpu_s(pid: int) -> float | None:
             continue
         total = (total or 0.0) + ticks / _TICKS
         for task in _tasks(p):
-            todo.extend(_children(task / "children"))
+            children = _children(task / "children")
+            if children is None:
+                return None
+            todo.extend(children)
     return total
 
 
@@ -52,8 +56,12 @@ def _tasks(pid: int) -> list[Path]:
         return []
 
 
-def _children(path: Path) -> list[int]:
+def _children(path: Path) -> list[int] | None:
+    """The pids a task's ``children`` file lists; None where the kernel has no such file; none
+    where the task has gone."""
     try:
         return [int(c) for c in path.read_text().split()]
+    except FileNotFoundError:
+        return None if path.parent.exists() else []
     except (OSError, ValueError):
         return []
