@@ -18,6 +18,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -79,18 +80,22 @@ def metrics(case: Path) -> dict:
     return json.loads((case / "metrics.json").read_text())
 
 
-def sigterm_run(case: Path, written: str, settle: float = 0.0) -> int:
-    """`ehlfoam run case` in its own process, sent SIGTERM once ``case/written`` exists
-    (and ``settle`` seconds more); its exit code."""
+def sigterm_run(case: Path, written: str, going_on: Callable[[], bool]) -> int:
+    """`ehlfoam run case` in its own process, sent SIGTERM while it runs; its exit code. A
+    tiny run ends within a second, so the signal is not timed: once ``case/written`` exists
+    the run is stopped (SIGSTOP), ``going_on()`` must say from what it has written that it
+    is still within the loop that takes SIGTERM, and it is sent SIGTERM and let go on."""
     proc = subprocess.Popen([sys.executable, "-m", "ehlfoam", "run", str(case), "--quiet"],
                             env={**os.environ, **NO_FOAM}, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 60
         while not (case / written).exists() and time.monotonic() < deadline:
-            time.sleep(0.05)
-        time.sleep(settle)
+            time.sleep(0.01)
+        proc.send_signal(signal.SIGSTOP)
+        assert going_on(), f"the run of {case} had ended: nothing left to interrupt"
         proc.send_signal(signal.SIGTERM)
+        proc.send_signal(signal.SIGCONT)
         return proc.wait(timeout=60)
     finally:
         if proc.poll() is None:
@@ -208,7 +213,14 @@ def test_sigterm_ends_the_run_interrupted_with_its_state_written(ran, tmp_path):
     spec = json.loads((case / "ehlfoam" / "spec.json").read_text())
     spec["run"]["steady_tolerance"] = 1e-9                   # never steady: it runs on
     (case / "ehlfoam" / "spec.json").write_text(json.dumps(spec))
-    assert sigterm_run(case, "history.csv") == 1   # not finished: metrics.json says why
+    transit = json.loads((case / "ehlfoam" / "geometry.json").read_text())["transit_time"]
+
+    def marching() -> bool:        # short of its transits_max: it marches on
+        with open(case / "history.csv", newline="") as fh:
+            last = float(list(csv.DictReader(fh))[-1]["time_s"])
+        return last < (spec["run"]["transits_max"] - 1) * transit
+
+    assert sigterm_run(case, "history.csv", marching) == 1   # not finished: metrics.json says why
     m = metrics(case)
     assert (m["status"], m["end_reason"]) == ("interrupted", "interrupted")
     assert load_state(case / "state.npz").time == pytest.approx(m["simulated_time_s"])
