@@ -72,12 +72,13 @@ def test_every_warning_the_package_raises_is_a_notice_that_fits_at_extreme_value
     """Built at values far past their limits (wider numbers), each source's notice is valid
     (the constructor checks length and form) and names its code and docs."""
     raised = [*mesh_warnings(tiny_geometry(ball_wall_steps=999.9)),
-              *rear_cell_warnings(123.45), *front_cell_warnings(98765.0),
+              *rear_cell_warnings(123.45), *rear_cell_warnings(123.45, follows=True),
+              *front_cell_warnings(98765.0),
               *boundary_warnings(1.0, {"flooded_clearance_over_a": 0.0,
                                        "flooded_nearest_boundary": "upstream"}),
               *enclosure_warnings({"enclosed_bubbles": 99}, np.zeros((9, 9), bool))]
     assert [n.code for n in raised] == ["ball-wall-steps", "rear-meniscus-cells",
-                                        "front-contact-line-cells", "outflow-off-outlet",
+                                        "rear-meniscus-cells", "front-contact-line-cells", "outflow-off-outlet",
                                         "region-near-boundary", "closed-within-a-cell"]
     assert all(n.docs.startswith("docs/") for n in raised)
     for n in raised:   # each pointer names a page and one of its sections
@@ -87,6 +88,8 @@ def test_every_warning_the_package_raises_is_a_notice_that_fits_at_extreme_value
     # and none below their limits
     assert not mesh_warnings(tiny_geometry(ball_wall_steps=BALL_WALL_STEPS_LIMIT))
     assert not rear_cell_warnings(REAR_CELL_WARNING)
+    assert "mesh.follow.half_width" in rear_cell_warnings(0.5, follows=True)[0].text
+    assert "mesh.refine" in rear_cell_warnings(0.5)[0].text
     assert not front_cell_warnings(FRONT_CELL_WARNING)
     cavity = np.zeros((9, 9), bool)
     assert not enclosure_warnings({"enclosed_bubbles": 0}, cavity)   # open wake: state II

@@ -92,7 +92,7 @@ def final_record(case: Path, spec: CaseSpec, geom: CaseGeometry,
         "rear_meniscus_cell_over_a": rear_cell,
         "front_contact_line_cells_over_wall_cell": front_cells,
         "warnings": to_text(
-            mesh_warnings(geom) + rear_cell_warnings(rear_cell)
+            mesh_warnings(geom) + rear_cell_warnings(rear_cell, spec.mesh.follow is not None)
             + front_cell_warnings(front_cells, spec.physics.isotropic_compression)
             + (boundary_warnings(off_outlet, pattern) if surrounded else [])),
     }

@@ -96,15 +96,18 @@ def rear_meniscus_cell(spec: CaseSpec, pattern: dict | None) -> float | None:
     return float(size_function(spec)(x_rear * spec.a, 0.0) / spec.a)
 
 
-def rear_cell_warnings(rear_cell: float | None) -> list[Notice]:
+def rear_cell_warnings(rear_cell: float | None, follows: bool = False) -> list[Notice]:
     """A warning when the rear meniscus sits in cells (``rear_cell``, units a) coarser than
-    :data:`REAR_CELL_WARNING`, naming what refines them."""
+    :data:`REAR_CELL_WARNING`, naming what refines them: in a mesh that ``follows`` its start
+    state's meniscus (``mesh.follow``), a wider band, which the region has grown out of."""
     if rear_cell is None or rear_cell <= REAR_CELL_WARNING:
         return []
-    return [Notice("rear-meniscus-cells",
-                   f"the rear meniscus sits in {rear_cell:.2f} a cells (above "
-                   f"{REAR_CELL_WARNING:g} a): its films, the oil held and the width are off, "
-                   f"refine there (mesh.refine as in nominal_films.toml)",
+    effect = (f"the rear meniscus sits in {rear_cell:.2f} a cells (above "
+              f"{REAR_CELL_WARNING:g} a): its films, ")
+    fix = ("oil and width are off: widen the followed band (mesh.follow.half_width)"
+           if follows else "the oil held and the width are off, refine there (mesh.refine "
+           "as in nominal_films.toml)")
+    return [Notice("rear-meniscus-cells", effect + fix,
                    "docs/models/interface.md#rear-meniscus-cells")]
 
 
