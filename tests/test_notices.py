@@ -78,7 +78,8 @@ def test_every_warning_the_package_raises_is_a_notice_that_fits_at_extreme_value
                                        "flooded_nearest_boundary": "upstream"}),
               *enclosure_warnings({"enclosed_bubbles": 99}, np.zeros((9, 9), bool))]
     assert [n.code for n in raised] == ["ball-wall-steps", "rear-meniscus-cells",
-                                        "rear-meniscus-cells", "front-contact-line-cells", "outflow-off-outlet",
+                                        "rear-meniscus-cells", "front-contact-line-cells",
+                                        "outflow-off-outlet",
                                         "region-near-boundary", "closed-within-a-cell"]
     assert all(n.docs.startswith("docs/") for n in raised)
     for n in raised:   # each pointer names a page and one of its sections
