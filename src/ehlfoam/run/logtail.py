@@ -14,7 +14,7 @@ __all__ = ["LogTail"]
 
 _STEP_OR_TIME = re.compile(r"^(deltaT|Time) = ([-+0-9.eE]+)\s*$", re.M)
 #: a crash handler's first words: OpenFOAM's backtrace, UCX's
-_BACKTRACE = re.compile(r"^#0 +Foam::error::printStack|Caught signal \d+", re.M)
+_BACKTRACE = re.compile(rb"^#0 +Foam::error::printStack|Caught signal \d+", re.M)
 
 
 class LogTail:
@@ -56,8 +56,7 @@ class LogTail:
         self.grew = self.offset + len(chunk) > self._size
         self._size = max(self._size, self.offset + len(chunk))
         # a handler may hang in the middle of a line: its words are looked for in that too
-        self.backtrace = self.backtrace or _BACKTRACE.search(
-            chunk.decode("utf-8", "replace")) is not None
+        self.backtrace = self.backtrace or _BACKTRACE.search(chunk) is not None
         cut = chunk.rfind(b"\n") + 1
         self.offset += cut
         text = chunk[:cut].decode("utf-8", "replace")

@@ -19,7 +19,7 @@ import numpy as np
 
 from ehlfoam._io import atomic_write_text
 from ehlfoam.case.geometry import META, load_geometry, load_spec_of
-from ehlfoam.foam.fieldfile import field_file, is_complete
+from ehlfoam.foam.fieldfile import IncompleteField, field_file
 from ehlfoam.run.fields import Structure, time_folders, uniform_or_list
 
 __all__ = ["OUTFLOW_FILE", "OUTFLOW_ROW", "OUTLET", "outlet_layers", "write_outflow"]
@@ -45,25 +45,27 @@ def outlet_layers(case: str | Path, row: float, rows: int,
     structure = Structure.load(case)
     if OUTLET not in structure.patches:
         raise ValueError(f"{case} has no {OUTLET!r} patch")
-    if time_folder is None:
-        written = [f for t, f in time_folders(case) if t > 0 and _written_whole(f)]
-        if not written:
-            raise ValueError(f"{case} has no written time after the start")
-        time_folder = written[-1]
     start, size = structure.patches[OUTLET]
     y = np.abs(np.load(case / META / "mesh.npz")["face_centres_boundary"][start:start + size, 1])
-    flux = _outlet_oil_flux(Path(time_folder), size)
+    flux = (_outlet_oil_flux(Path(time_folder), size) if time_folder is not None
+            else _last_whole_flux(case, size))
     band = np.minimum((y / row).astype(int), rows - 1)
     per_row = np.bincount(band, weights=flux, minlength=rows)
     # a full mesh folds both sides of the track onto each row: half of it is the row's
     return per_row / (spec.speed * row * (1.0 if geom.symmetric else 2.0))
 
 
-def _written_whole(folder: Path) -> bool:
-    """The flux files the outlet's oil is read from are complete in ``folder``."""
-    if (folder / "alphaPhi0.oil").exists():
-        return is_complete(folder / "alphaPhi0.oil")
-    return is_complete(folder / "phi") and is_complete(folder / "alpha.oil")
+def _last_whole_flux(case: Path, size: int) -> np.ndarray:
+    """The outlet's oil flux at the last written time whose files are whole (a write cut
+    short, or missing a file, is passed over). ValueError without one after the start."""
+    for t, folder in reversed(time_folders(case)):
+        if t <= 0:
+            break
+        try:
+            return _outlet_oil_flux(folder, size)
+        except (IncompleteField, FileNotFoundError):   # cut short, or not written yet
+            continue
+    raise ValueError(f"{case} has no written time after the start")
 
 
 def _outlet_oil_flux(folder: Path, size: int) -> np.ndarray:
