@@ -10,7 +10,7 @@ from ehlfoam.case.geometry import BALL_WALL_STEPS_LIMIT, mesh_warnings
 from ehlfoam.notices import MAX_TEXT, Notice, NoticeTally, from_text, to_text
 from ehlfoam.run.monitor import (FRONT_CELL_WARNING, REAR_CELL_WARNING, boundary_warnings,
                                  front_cell_warnings, rear_cell_warnings)
-from ehlfoam.run.warnings import enclosure_warnings
+from ehlfoam.run.warnings import bare_track_warnings, enclosure_warnings
 from tests.test_docs_links import ROOT, _anchors
 from tests.tiny import tiny_geometry
 
@@ -73,13 +73,13 @@ def test_every_warning_the_package_raises_is_a_notice_that_fits_at_extreme_value
     (the constructor checks length and form) and names its code and docs."""
     raised = [*mesh_warnings(tiny_geometry(ball_wall_steps=999.9)),
               *rear_cell_warnings(123.45), *rear_cell_warnings(123.45, follows=True),
-              *front_cell_warnings(98765.0),
+              *front_cell_warnings(98765.0), *bare_track_warnings(1.0),
               *boundary_warnings(1.0, {"flooded_clearance_over_a": 0.0,
                                        "flooded_nearest_boundary": "upstream"}),
               *enclosure_warnings({"enclosed_bubbles": 99}, np.zeros((9, 9), bool))]
     assert [n.code for n in raised] == ["ball-wall-steps", "rear-meniscus-cells",
                                         "rear-meniscus-cells", "front-contact-line-cells",
-                                        "outflow-off-outlet",
+                                        "supply-layers-broken", "outflow-off-outlet",
                                         "region-near-boundary", "closed-within-a-cell"]
     assert all(n.docs.startswith("docs/") for n in raised)
     for n in raised:   # each pointer names a page and one of its sections

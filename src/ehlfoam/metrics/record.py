@@ -292,6 +292,10 @@ class MetricsRecord(BaseModel):
         "Median in-plane cell size over wall cell height along the flooded region's front "
         "where dry walls run into it off the track", "1",
         "In-plane cells over wall cells where dry walls run into the region", "")
+    supply_track_bare_fraction: float | None = _key(
+        "Share of the supply track's columns upstream of the flooded region holding under a "
+        "quarter of the supplied layers' oil (the layers broken into drops)", "1",
+        "Supply track bare upstream of the region", "%", 100.0)
     warnings: str | None = _text("Warnings on the mesh and the open boundaries, '; '-joined",
                                  "Warnings (mesh, open boundaries)")
     log_tail: list[str] | None = _text("The solver log's last lines (a failed run)",

@@ -26,6 +26,12 @@ SUPPLY_PATCH = "supply"
 OPEN_PATCHES = (SUPPLY_PATCH, "inlet", "outlet", "side")
 
 
+#: :func:`bare_track_share`: the part of the track's half width it reads (its edges, where the
+#: layers end, excluded) and the oil below which a column counts as bare (of the layers)
+BARE_TRACK_SPAN = 0.8
+BARE_TRACK_OIL = 0.25
+
+
 @dataclass
 class Structure:
     """The mesh structure the generator stored in ``ehlfoam/mesh.npz``."""
@@ -286,6 +292,23 @@ def advancing_front_cells(folder: Path, structure: Structure, geom: CaseGeometry
     _, i = cKDTree(np.stack([structure.base_x, structure.base_y], 1)).query(
         np.stack([points[:, 0], y], 1))
     return np.sqrt(structure.footprint[i]) / structure.wall_cell[i]
+
+
+def bare_track_share(folder: Path, structure: Structure, geom: CaseGeometry,
+                     track_half_width: float, layers: float, upstream_of: float) -> float | None:
+    """The share of the supply track's columns upstream of ``upstream_of`` [m] (x below it,
+    |y| within 0.8 of ``track_half_width`` [m]) whose oil, across the gap at ``folder``, is
+    under a quarter of the ``layers`` [m] the supply carries on both walls: near 0 where the
+    layers arrive whole; a large share where they broke into drops on the way. None with fewer
+    than 5 such columns."""
+    sel = ((structure.base_x < upstream_of)
+           & (np.abs(structure.base_y) < BARE_TRACK_SPAN * track_half_width))
+    if np.count_nonzero(sel) < 5:
+        return None
+    alpha = read_alpha(folder / "alpha.oil", structure)
+    oil = np.bincount(structure.base_cell, alpha * structure.cell_volumes,
+                      minlength=len(structure.base_x)) / structure.footprint
+    return float(np.mean(oil[sel] < BARE_TRACK_OIL * layers))
 
 
 def off_outlet_share(out_by_boundary: dict[str, float]) -> float | None:

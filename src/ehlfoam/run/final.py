@@ -12,9 +12,9 @@ from ehlfoam.notices import to_text
 from ehlfoam.metrics.record import MetricsRecord
 from ehlfoam.run import fields as case_fields
 from ehlfoam.run.balance import dissolved_air_budget, mass_balance
-from ehlfoam.run.warnings import (boundary_warnings, front_cell_warnings,
-                                  front_contact_line_cells, rear_cell_warnings,
-                                  rear_meniscus_cell)
+from ehlfoam.run.warnings import (bare_track, bare_track_warnings, boundary_warnings,
+                                  front_cell_warnings, front_contact_line_cells,
+                                  rear_cell_warnings, rear_meniscus_cell)
 from ehlfoam.spec.case import CaseSpec
 
 __all__ = ["RunEnd", "final_record"]
@@ -60,6 +60,7 @@ def final_record(case: Path, spec: CaseSpec, geom: CaseGeometry,
     rear_cell = rear_meniscus_cell(spec, pattern) if surrounded else None
     front_cells = (front_contact_line_cells(spec, geom, structure, case, pattern)
                    if surrounded and not end.failed else None)
+    bare = bare_track(spec, geom, structure, case, pattern) if not end.failed else None
     out = {
         "status": end.status,
         "end_reason": end.reason,
@@ -91,9 +92,11 @@ def final_record(case: Path, spec: CaseSpec, geom: CaseGeometry,
         "ball_wall_steps": geom.ball_wall_steps,
         "rear_meniscus_cell_over_a": rear_cell,
         "front_contact_line_cells_over_wall_cell": front_cells,
+        "supply_track_bare_fraction": bare,
         "warnings": to_text(
             mesh_warnings(geom) + rear_cell_warnings(rear_cell, spec.mesh.follow is not None)
             + front_cell_warnings(front_cells, spec.physics.isotropic_compression)
+            + bare_track_warnings(bare)
             + (boundary_warnings(off_outlet, pattern) if surrounded else [])),
     }
     if end.failed:
