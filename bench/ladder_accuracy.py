@@ -18,8 +18,9 @@ wall time and 6 transits (``--set-3d`` sets a spec option on the 3D rungs alone,
 ``--rungs``) that came to rest (``steady``). Per metric (state, inlet meniscus, flooded
 width, bubble or wake length, oil held) each rung's error against it: the state right or
 wrong, the others relative, each metric the run's mean over its last transit (a single
-write carries the menisci's jitter; the last write's where the state changed within it).
-Cost: the CPU time of the run (the process's own, the thin-film start included, plus the
+write carries the menisci's jitter; the last write's where the state changed within it),
+and on the 3D rungs how much of the supply track upstream of the region its last write left
+bare (the layers broken into drops: docs/models/interface.md#supply-layers-broken). Cost: the CPU time of the run (the process's own, the thin-film start included, plus the
 OpenFOAM solver's on every rank), the EHL precalc excluded (solved first, cached). Prints a
 row per point and rung and a summary per rung (error, median CPU, CPU against the
 reference's); ``--charts DIR`` draws one chart per metric, error against CPU (log axis), a
@@ -102,7 +103,7 @@ def run_point(label: str, rung: str, spec: CaseSpec, case: Path) -> dict:
     cpu = time.process_time() - c0 + (solver_cpu_s(case) or 0.0) * spec.run.n_procs
     row = {"point": label, "rung": rung, "cpu_s": cpu, "wall_s": time.perf_counter() - t0,
            "end_reason": m.get("end_reason"), "steady": bool(m.get("steady")),
-           "state": m.get("state")}
+           "state": m.get("state"), "bare_track": m.get("supply_track_bare_fraction")}
     row.update(last_transit_metrics(case, m))
     return row
 
@@ -281,7 +282,8 @@ def main(argv: list[str] | None = None) -> int:
         ("state", "state", ""), ("steady", "at rest", ""), ("inlet", "inlet [a]", ".2f"),
         ("width", "width [a]", ".2f"),
         ("bubble", "bubble [a]", ".2f"), ("wake", "wake [a]", ".2f"),
-        ("oil", "oil [m3]", ".3g"), ("cpu_s", "CPU [s]", ".1f"), ("reference", "ref", ""),
+        ("oil", "oil [m3]", ".3g"), ("bare_track", "bare track", ".0%"),
+        ("cpu_s", "CPU [s]", ".1f"), ("reference", "ref", ""),
         ("err_inlet", "e inlet", ".3f"), ("err_width", "e width", ".3f"),
         ("err_bubble", "e bubble", ".3f"), ("err_oil", "e oil", ".3f")],
         "every point on every rung (errors relative to the point's reference)")

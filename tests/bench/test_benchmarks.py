@@ -144,6 +144,7 @@ def test_ladder_accuracy_measures_each_rung_against_the_finest_at_rest(tmp_path)
         assert r["state_ok"] == (r["state"] == ref["state"])
         # each metric the mean of the last transit's writes (two a transit: two or three)
         assert r["writes_averaged"] in (2, 3) and r["jitter_width"] >= 0
+        assert r["bare_track"] is None        # the thin-film model carries its layers exactly
     assert {r["state"] for r in rows} == {"I", "II"}            # 8 mm/s I, 17 mm/s II
     assert [s["rung"] for s in rec["summary"]] == ["thin-film-coarse", "thin-film-medium"]
     assert rec["summary"][1]["max_width"] == 0 and rec["summary"][1]["cpu_over_reference"] == 1
