@@ -20,8 +20,9 @@ width, bubble or wake length, oil held) each rung's error against it: the state 
 wrong, the others relative, each metric the run's mean over its last transit (a single
 write carries the menisci's jitter; the last write's where the state changed within it),
 and on the 3D rungs how much of the supply track upstream of the region its last write left
-bare (the layers broken into drops: docs/models/interface.md#supply-layers-broken). Cost: the CPU time of the run (the process's own, the thin-film start included, plus the
-OpenFOAM solver's on every rank), the EHL precalc excluded (solved first, cached). Prints a
+bare (the layers broken into drops: docs/models/interface.md#supply-layers-broken). Cost:
+the CPU time of the run (the process's own, the thin-film start included, plus the OpenFOAM
+solver's on every rank), the EHL precalc excluded (solved first, cached). Prints a
 row per point and rung and a summary per rung (error, median CPU, CPU against the
 reference's); ``--charts DIR`` draws one chart per metric, error against CPU (log axis), a
 marker per rung. ``--join`` adds the rows of earlier runs (their ``--out``) at the points

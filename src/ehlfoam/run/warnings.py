@@ -1,7 +1,7 @@
 """The run's warnings: oil leaving off the outlet, a flooded region near an open boundary, a
 rear meniscus in coarse cells, a front off the track in cells too wide for its contact line,
-a thin-film bubble that closes within a cell, supply layers broken into drops. Each names what to change; the run records
-them in metrics.json (``warnings``)."""
+a thin-film bubble that closes within a cell, supply layers broken into drops. Each names
+what to change; the run records them in metrics.json (``warnings``)."""
 
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ FRONT_CELL_WARNING = 15.0
 #: The share of the supply track's columns upstream of the flooded region left bare (under a
 #: quarter of the supplied layers) above which a run warns: the layers broke into drops on
 #: the way in. Whole layers leave none bare; a wall angle above the oil's static one, as the
-#: resolved rungs' Cox-Voinov angle, breaks sub-micron layers: 22 % bare after 0.3 transit at
+#: resolved rungs' Cox-Voinov angle, breaks sub-micron layers: 33 % bare after 0.3 transit at
 #: 40 C, 8 mm/s, 0.45 um (docs/models/interface.md#supply-layers-broken).
 BARE_TRACK_WARNING = 0.1
 #: how far upstream of the flooded region (units a) the bare track is read
