@@ -68,8 +68,17 @@ class Structure:
     def column_gaps(self) -> np.ndarray:
         """Per base cell, the gap across its column [m]: the column's volume over its
         footprint."""
-        return np.bincount(self.base_cell, self.cell_volumes, minlength=len(self.base_x)) \
-            / self.footprint
+        return self._over_footprint(self.cell_volumes)
+
+    def column_oil(self, alpha: np.ndarray) -> np.ndarray:
+        """Per base cell, the oil across its column [m]: the oil's volume in it (``alpha``, the
+        oil fraction per cell) over its footprint."""
+        return self._over_footprint(np.asarray(alpha, float) * self.cell_volumes)
+
+    def _over_footprint(self, volumes: np.ndarray) -> np.ndarray:
+        """Per base cell, the sum of a per-cell volume [m3] over its column, over its
+        footprint [m]."""
+        return np.bincount(self.base_cell, volumes, minlength=len(self.base_x)) / self.footprint
 
     def gap_mean(self, field: np.ndarray) -> np.ndarray:
         """Per base cell, the volume-weighted mean of a cell field over the column across the
@@ -297,17 +306,16 @@ def advancing_front_cells(folder: Path, structure: Structure, geom: CaseGeometry
 def bare_track_share(folder: Path, structure: Structure, geom: CaseGeometry,
                      track_half_width: float, layers: float, upstream_of: float) -> float | None:
     """The share of the supply track's columns upstream of ``upstream_of`` [m] (x below it,
-    |y| within 0.8 of ``track_half_width`` [m]) whose oil, across the gap at ``folder``, is
-    under a quarter of the ``layers`` [m] the supply carries on both walls: near 0 where the
-    layers arrive whole; a large share where they broke into drops on the way. None with fewer
-    than 5 such columns."""
+    |y| within :data:`BARE_TRACK_SPAN` of ``track_half_width`` [m]) whose oil across the gap
+    at ``folder`` (:meth:`Structure.column_oil`) is under :data:`BARE_TRACK_OIL` of the
+    ``layers`` [m] the supply carries on both walls: near 0 where the layers arrive whole; a
+    large share where they broke into drops on the way. None with fewer than 5 such
+    columns."""
     sel = ((structure.base_x < upstream_of)
            & (np.abs(structure.base_y) < BARE_TRACK_SPAN * track_half_width))
     if np.count_nonzero(sel) < 5:
         return None
-    alpha = read_alpha(folder / "alpha.oil", structure)
-    oil = np.bincount(structure.base_cell, alpha * structure.cell_volumes,
-                      minlength=len(structure.base_x)) / structure.footprint
+    oil = structure.column_oil(read_alpha(folder / "alpha.oil", structure))
     return float(np.mean(oil[sel] < BARE_TRACK_OIL * layers))
 
 

@@ -161,8 +161,10 @@ def bare_track(spec: CaseSpec, geom: CaseGeometry, structure: case_fields.Struct
     whole last write."""
     supply = spec.supply
     layers = supply.disc_layer + supply.ball_layer
+    if supply.mode != "layers" or layers <= 0.0:
+        return None
     folders = case_fields.time_folders(case)
-    if supply.mode != "layers" or layers <= 0.0 or not folders:
+    if not folders:
         return None
     front = (pattern or {}).get("flooded_x_min_over_a")
     upstream_of = (front * geom.a if front is not None else -geom.island_radius) \
@@ -183,4 +185,3 @@ def bare_track_warnings(share: float | None) -> list[Notice]:
                    f"{share:.0%} of the supply track upstream of the region is bare: the layers "
                    f"broke into drops on the way in, the inlet meniscus and the oil are off",
                    "docs/models/interface.md#supply-layers-broken")]
-
