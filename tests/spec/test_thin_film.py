@@ -11,6 +11,7 @@ from ehlfoam.errors import SpecError
 from ehlfoam.spec.case import make_case_spec
 from ehlfoam.spec.thin_film import (THIN_FILM_CELLS, THREE_D_ONLY, ThinFilm, thin_film_cell,
                                     thin_film_cells)
+from ehlfoam.thinfilm.from_spec import scene_options
 
 
 def thin(**overrides):
@@ -51,8 +52,11 @@ def test_the_cell_is_the_levels_unless_given(level):
     ("physics.cavitation_pressure", 1e5, None),
     ("thin_film.normal_length", 0.01, "thin_film.normal_length = 0.01 a is out of range: must "
                                       "be none or in [0.1, 3.25] a"),
-    ("thin_film.advancing_angle", 10.0, "thin_film.advancing_angle = 10 deg is out of range: "
-                                        "must be none or in [15, 90) deg"),
+    ("physics.advancing_angle", 95.0, "physics.advancing_angle = 95 deg is out of range for "
+                                      'scene = "thin-film": must be none or in [15, 90) deg'),
+    ("physics.receding_angle", 5.0, "physics.receding_angle = 5.0 does not apply"),
+    ("thin_film.advancing_angle", 40.0, "advancing_angle has moved to "
+                                        "physics.advancing_angle"),
     ("thin_film.receding_meniscus", 3.0, 'must be "static", "bretherton" or a factor in '
                                          "[0.5, 2]"),
 ])
@@ -90,9 +94,10 @@ def test_the_keys_it_reads_and_a_3d_default_restated_are_taken():
                    "physics.cavitation_pressure": 9e4, "physics.contact_angle": 20.0,
                    "domain.side": 11.0, "run.transits_max": 100.0, "run.wall_limit": 60.0,
                    "mesh.resolution": "coarse", "mesh.polar_radius": "auto",
-                   "thin_film.receding_meniscus": 1.2, "thin_film.advancing_angle": 40.0})
+                   "thin_film.receding_meniscus": 1.2, "physics.advancing_angle": 40.0})
     assert spec.solver == "thin-film"
     assert spec.thin_film.receding_meniscus == 1.2
+    assert scene_options(spec).advancing_angle == 40.0
 
 
 def test_the_3d_scenes_ignore_the_thin_film_table():

@@ -14,6 +14,7 @@ from ehlfoam.case import face_oil
 from ehlfoam.case.foam_lists import fill_placeholders, placeholder
 from ehlfoam.case.geometry import CaseGeometry
 from ehlfoam.case.stop import stop_entries, write_boundary_data
+from ehlfoam.case.wall_angle import wall_angle_entry
 from ehlfoam.case.wall_slip import navier_slip, rolling_velocity, wall_normals, write_slip_walls
 from ehlfoam.mesh import PolyMesh, split_patch
 from ehlfoam.spec.case import CaseSpec
@@ -152,7 +153,7 @@ def edit_fields(spec: CaseSpec, case: Path, mesh: PolyMesh, fraction: np.ndarray
             del f.boundary_field["symmetry"]
     with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
         f.internal_field = initial_alpha(spec, mesh, gap)
-        f.boundary_field['"(disc|ball|island)"']["theta0"] = spec.physics.contact_angle
+        f.boundary_field['"(disc|ball|island)"'] = wall_angle_entry(spec)
         if len(supply):
             f.boundary_field["supply"]["value"] = (supply if len(supply) not in (3, 6, 9)
                                                    else placeholder("supply", "value"))

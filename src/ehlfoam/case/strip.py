@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 from foamlib import FoamFieldFile
 
+from ehlfoam.case.wall_angle import wall_angle_entry
 from ehlfoam.case.wall_slip import write_slip_walls
 from ehlfoam.case.dictionaries import edit_physics_dicts, edit_run_control
 from ehlfoam.case.fields import slip_walls, wall_layers_fraction
@@ -105,7 +106,7 @@ def write_strip_case(spec: CaseSpec, case: Path, mesh: PolyMesh, x_bridge: float
         f.boundary_field["side"] = {"type": side}
     with FoamFieldFile(case / "0.orig" / "alpha.oil") as f:
         f.internal_field = (mesh.cell_centres[:, 0] < x_bridge).astype(float)
-        f.boundary_field['"(disc|ball|island)"']["theta0"] = spec.physics.contact_angle
+        f.boundary_field['"(disc|ball|island)"'] = wall_angle_entry(spec)
         f.boundary_field["supply"]["value"] = 1.0
         f.boundary_field["side"] = {"type": side}
     with FoamFieldFile(case / "0.orig" / "p_rgh") as f:

@@ -71,6 +71,8 @@ SPEC: dict[str, Unit] = {k: Unit(*v) for k, v in {
     "supply.initial_puddle": ("Initial puddle radius", "a", 1.0),
     "physics.surface_tension": ("Surface tension", "mN/m", 1e3),
     "physics.contact_angle": ("Contact angle", "deg", 1.0),
+    "physics.advancing_angle": ("Advancing contact angle", "deg", 1.0),
+    "physics.receding_angle": ("Receding contact angle", "deg", 1.0),
     "physics.oil_density": ("Oil density", "kg/m3", 1.0),
     "physics.air_density": ("Air density", "kg/m3", 1.0),
     "physics.air_viscosity": ("Air viscosity", "uPa s", 1e6),

@@ -132,6 +132,24 @@ class Physics(BaseModel):
         15.0, ge=0.0, le=180.0,
         description="Static contact angle of the oil on the disc, the ball and the island.",
         json_schema_extra={"unit": "deg"})
+    advancing_angle: float | None = Field(
+        None, ge=0.0, le=180.0,
+        description="Apparent contact angle of a meniscus that the walls run into over dry "
+                    "ground (Cox-Voinov's dependence on the speed across the line): in the "
+                    "thin-film scene the menisci off the track that the walls run into; in "
+                    "the 3D scenes, with receding_angle, a contact line the oil advances "
+                    "over the wall (docs/models/interface.md#a-wall-angle-that-follows-the-"
+                    "line). None: contact_angle.",
+        json_schema_extra={"unit": "deg"})
+    receding_angle: float | None = Field(
+        None, ge=0.0, le=180.0,
+        description="3D scenes: the contact angle of a line that the oil recedes over the "
+                    "wall. With advancing_angle or this set the walls' angle follows the "
+                    "oil's speed across the line relative to the wall, from receding_angle "
+                    "to advancing_angle (a tanh over a tenth of the rolling speed), and "
+                    "oil at rest on the wall (a line at rest, the layers the walls carry) "
+                    "takes their mean, not contact_angle. None: contact_angle.",
+        json_schema_extra={"unit": "deg"})
     oil_density: float | None = Field(
         None, gt=0.0, le=1e4,
         description="Oil density; none takes the lubricant's rho0.",
@@ -228,6 +246,23 @@ class Physics(BaseModel):
                     "mineral oils). The run reports its gas release against it; the "
                     "thin-film scene's gas balance (thin_film.bubble_gas = \"balance\") takes "
                     "it as Henry's law's Ostwald coefficient, C = s p / (R T).")
+
+    @model_validator(mode="after")
+    def _angles_in_order(self) -> "Physics":
+        advancing, receding = self.wall_angles
+        if receding > advancing:
+            raise ValueError(f"receding_angle = {receding:g} deg must not exceed "
+                             f"advancing_angle = {advancing:g} deg (either one unset is "
+                             f"contact_angle = {self.contact_angle:g} deg)")
+        return self
+
+    @property
+    def wall_angles(self) -> tuple[float, float]:
+        """(advancing, receding) contact angles [deg], an unset one the static
+        ``contact_angle``."""
+        c = self.contact_angle
+        return (c if self.advancing_angle is None else self.advancing_angle,
+                c if self.receding_angle is None else self.receding_angle)
 
 
 @dataclass(frozen=True)

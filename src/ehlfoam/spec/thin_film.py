@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from typing import Any, Literal
 
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, Field, field_validator, model_validator
 
 from ehlfoam.errors import SpecError
 from ehlfoam.spec.sections import STRICT
@@ -51,7 +51,7 @@ THREE_D_ONLY: dict[str, tuple[tuple[str, ...], str]] = {
     "physics": (("oil_density", "air_density", "air_viscosity", "interface_compression",
                  "isotropic_compression", "interface_schemes", "interface_advection",
                  "wall_slip_length", "oil_bulk_modulus", "gas_release_rate",
-                 "gas_dissolution_rate"),
+                 "gas_dissolution_rate", "receding_angle"),
                 "the gap-averaged model has no inertia, no air flow, no interface numerics "
                 "and no gas-release kinetics"),
     "mesh": (("n_layers", "size_rim", "size_far", "wall_grading", "wall_cell",
@@ -70,6 +70,14 @@ class ThinFilm(BaseModel):
     grid and closures. The 3D scenes ignore this table."""
 
     model_config = STRICT
+
+    @model_validator(mode="before")
+    @classmethod
+    def _moved_keys(cls, data: Any) -> Any:
+        if isinstance(data, dict) and "advancing_angle" in data:
+            raise ValueError("advancing_angle has moved to physics.advancing_angle (the 3D "
+                             "scenes' walls read it too): set physics.advancing_angle")
+        return data
     cell: float | None = Field(
         None, ge=0.01, le=10.0,
         description="Size of the model's square cells; none: the level's "
@@ -86,12 +94,6 @@ class ThinFilm(BaseModel):
                     '"static", Young-Laplace\'s like every other; "bretherton", that of a '
                     'meniscus laying films (Park and Homsy, 1 + 3.8 Ca^(2/3)); or a factor in '
                     '[0.5, 2] on the static one.')
-    advancing_angle: float | None = Field(
-        None, ge=0.0, lt=90.0,
-        description="Apparent contact angle of the menisci that dry walls run into off the "
-                    "track (Cox-Voinov's dependence on the speed across the line); none: "
-                    "physics.contact_angle.",
-        json_schema_extra={"unit": "deg"})
     normal_length: float | None = Field(
         0.3, gt=0.0, le=20.0,
         description="Length over which the flooded region is smoothed for the menisci's "
@@ -222,10 +224,11 @@ def check_thin_film(spec: CaseSpec) -> None:
         problems.append(f"thin_film.normal_length = {nl:g} a is out of range: must be none "
                         f"or in [{0.5 * cell:.3g}, {span:.3g}] a (half a cell to the span of "
                         "the grid)")
-    if tf.advancing_angle is not None and not tf.advancing_angle >= p.contact_angle:
-        problems.append(f"thin_film.advancing_angle = {tf.advancing_angle:g} deg is out of "
-                        f"range: must be none or in [{p.contact_angle:g}, 90) deg (the static "
-                        "angle, physics.contact_angle, up to a right angle)")
+    if p.advancing_angle is not None and not p.contact_angle <= p.advancing_angle < 90.0:
+        problems.append(f"physics.advancing_angle = {p.advancing_angle:g} deg is out of range "
+                        f"for scene = \"thin-film\": must be none or in [{p.contact_angle:g}, "
+                        "90) deg (the static angle, physics.contact_angle, up to a right "
+                        "angle)")
     if problems:
         raise SpecError("invalid case spec: " + "; ".join(problems))
 

@@ -92,7 +92,8 @@ def scene_options(spec: CaseSpec) -> RegionOptions:
     d, tf = spec.domain, spec.thin_film
     return RegionOptions(cell=thin_film_cell(spec), domain=(-d.upstream, d.downstream, d.side),
                          film_factor=tf.film_factor, receding=tf.receding_meniscus,
-                         advancing_angle=tf.advancing_angle, normal_length=tf.normal_length,
+                         advancing_angle=spec.physics.advancing_angle,
+                         normal_length=tf.normal_length,
                          cavitation=True, gas=tf.bubble_gas == "balance")
 
 
