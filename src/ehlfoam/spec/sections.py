@@ -138,8 +138,9 @@ class Physics(BaseModel):
                     "ground (Cox-Voinov's dependence on the speed across the line): in the "
                     "thin-film scene the menisci off the track that the walls run into; in "
                     "the 3D scenes, with receding_angle, a contact line the oil advances "
-                    "over the wall (docs/models/interface.md#a-wall-angle-that-follows-the-"
-                    "line). None: contact_angle.",
+                    "over the wall "
+                    "(docs/models/interface.md#a-wall-angle-that-follows-the-line). None: "
+                    "contact_angle.",
         json_schema_extra={"unit": "deg"})
     receding_angle: float | None = Field(
         None, ge=0.0, le=180.0,
