@@ -52,8 +52,9 @@ THREE_D_ONLY: dict[str, tuple[tuple[str, ...], str]] = {
                  "isotropic_compression", "interface_schemes", "interface_advection",
                  "wall_slip_length", "oil_bulk_modulus", "gas_release_rate",
                  "gas_dissolution_rate", "receding_angle"),
-                "the gap-averaged model has no inertia, no air flow, no interface numerics "
-                "and no gas-release kinetics"),
+                "the gap-averaged model has no inertia, no air flow, no interface numerics, "
+                "no gas-release kinetics and no receding contact line (its rear menisci lay "
+                "Landau-Levich films)"),
     "mesh": (("n_layers", "size_rim", "size_far", "wall_grading", "wall_cell",
               "polar_radius", "columns", "refine", "follow"),
              "the model's grid is square cells of thin_film.cell or the level's"),
@@ -70,14 +71,6 @@ class ThinFilm(BaseModel):
     grid and closures. The 3D scenes ignore this table."""
 
     model_config = STRICT
-
-    @model_validator(mode="before")
-    @classmethod
-    def _moved_keys(cls, data: Any) -> Any:
-        if isinstance(data, dict) and "advancing_angle" in data:
-            raise ValueError("advancing_angle has moved to physics.advancing_angle (the 3D "
-                             "scenes' walls read it too): set physics.advancing_angle")
-        return data
     cell: float | None = Field(
         None, ge=0.01, le=10.0,
         description="Size of the model's square cells; none: the level's "
@@ -129,6 +122,14 @@ class ThinFilm(BaseModel):
                     '40 C and 21.6 mPa s (HVI60), taken to the case\'s temperature T and '
                     'viscosity eta as T / eta^(2/3) (Hiss and Cussler).',
         json_schema_extra={"unit": "m2/s"})
+
+    @model_validator(mode="before")
+    @classmethod
+    def _moved_keys(cls, data: Any) -> Any:
+        if isinstance(data, dict) and "advancing_angle" in data:
+            raise ValueError("advancing_angle has moved to physics.advancing_angle (the 3D "
+                             "scenes' walls read it too): set physics.advancing_angle")
+        return data
 
     @field_validator("receding_meniscus")
     @classmethod
